@@ -1,0 +1,128 @@
+"""The method registry: every solver and heuristic, one signature, one front door.
+
+A method is a picklable module-level function::
+
+    method(instance: TOPInstance, *, seed: int, time_limit: float) -> Result
+
+Entries name their function as ``"module:function"`` and are imported on first use, so that
+listing methods (or running a heuristic) does not pay for importing every solver library.
+:func:`run_method` is the only way results are counted: it never raises, and it re-verifies
+every plan with the independent verifier.
+"""
+
+from __future__ import annotations
+
+import importlib
+import time
+import traceback
+from dataclasses import dataclass
+from typing import Callable
+
+from formulations.errors import SarcoverError
+from formulations.instance import TOPInstance, precheck
+from formulations.plan import Result, Status
+from formulations.verify import VerificationReport, verify
+
+
+@dataclass(frozen=True)
+class MethodSpec:
+    name: str
+    target: str  # "package.module:function"
+    exact: bool  # True if the method can prove optimality (returns bounds)
+    summary: str
+
+    def load(self) -> Callable[..., Result]:
+        module, func = self.target.split(":")
+        return getattr(importlib.import_module(module), func)
+
+
+_SPECS = [
+    MethodSpec("greedy", "heuristics.greedy:greedy", False,
+               "cheapest insertion by prize per energy, groups first (floor baseline)"),
+]
+
+METHODS: dict[str, MethodSpec] = {spec.name: spec for spec in _SPECS}
+
+
+class UnknownMethodError(SarcoverError):
+    def __init__(self, name: str):
+        super().__init__(f"unknown method {name!r}; known: {', '.join(METHODS)}")
+
+
+def get_method(name: str) -> MethodSpec:
+    try:
+        return METHODS[name]
+    except KeyError:
+        raise UnknownMethodError(name) from None
+
+
+def run_method(
+    name: str, instance: TOPInstance, *, seed: int = 0, time_limit: float = 60.0
+) -> tuple[Result, VerificationReport | None]:
+    """Run a registered method, verify its plan, and return (result, verifier report).
+
+    Never raises. A failing method, a plan the verifier rejects, or a bound below the verified
+    objective all come back as status ERROR with the reason. The objective is always the
+    verifier's, never the method's own claim.
+    """
+    spec = get_method(name)
+    t0 = time.perf_counter()
+    reason = precheck(instance)
+    if reason is not None:
+        return Result(name, Status.INFEASIBLE, reason=reason, runtime_s=time.perf_counter() - t0), None
+    try:
+        result = spec.load()(instance, seed=seed, time_limit=time_limit)
+    except Exception as exc:  # a method bug must not stop a benchmark
+        tb = traceback.format_exc(limit=-3).strip().splitlines()
+        return Result(
+            name, Status.ERROR, reason=f"{type(exc).__name__}: {exc}",
+            runtime_s=time.perf_counter() - t0, info={"traceback": tb},
+        ), None
+    result.method = name
+    if result.runtime_s <= 0.0:
+        result.runtime_s = time.perf_counter() - t0
+    report = None
+    if result.plan is not None:
+        report = verify(instance, result.plan)
+        if not report.valid:
+            result.info["claimed_status"] = str(result.status)
+            result.status = Status.ERROR
+            result.reason = "verifier rejected the plan: " + "; ".join(report.violations[:5])
+            result.objective = None
+            return result, report
+        result.objective = report.prize
+    elif result.status in (Status.OPTIMAL, Status.FEASIBLE):
+        result.info["claimed_status"] = str(result.status)
+        result.status = Status.ERROR
+        result.reason = f"status {result.info['claimed_status']} without a plan"
+    if result.bound is not None and result.objective is not None:
+        if result.bound < result.objective - 1e-6 * max(1.0, abs(result.objective)):
+            result.info["claimed_status"] = str(result.status)
+            result.status = Status.ERROR
+            result.reason = f"bound {result.bound:g} below verified objective {result.objective:g}"
+    if result.status == Status.OPTIMAL and result.bound is None:
+        result.bound = result.objective
+    return result, report
+
+
+def result_record(result: Result, report: VerificationReport | None, instance: TOPInstance) -> dict:
+    """Flat JSON-ready record of a run (the CLI's --json output and the harness row)."""
+    routes = [list(r) for r in result.plan.routes] if result.plan is not None else None
+    total = instance.total_prize
+    return {
+        "instance": instance.name,
+        "method": result.method,
+        "exact": get_method(result.method).exact if result.method in METHODS else None,
+        "status": str(result.status),
+        "objective": result.objective,
+        "bound": result.bound,
+        "coverage": (result.objective / total if total > 0 else 0.0) if result.objective is not None else None,
+        "covered": report.covered if report is not None and report.valid else None,
+        "routes": routes,
+        "energy": report.energy if report is not None else None,
+        "e_max": instance.budget,
+        "runtime_s": result.runtime_s,
+        "valid": bool(report is not None and report.valid),
+        "reason": result.reason,
+        "info": {k: v for k, v in result.info.items() if k != "traceback"},
+    }

@@ -1,0 +1,158 @@
+"""Instance files: the sarcover JSON format and the classic TOP benchmark text format."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from formulations.errors import InstanceError
+from formulations.instance import SARInstance, TOPInstance, to_top
+
+FORMAT = "sarcover-instance"
+FORMAT_VERSION = 1
+SAR_FIELDS = ("targets", "views", "uavs", "altitude", "pitch_deg", "e_fly", "e_image", "e_max")
+
+
+def sar_to_dict(sar: SARInstance) -> dict:
+    return {
+        "format": FORMAT,
+        "version": FORMAT_VERSION,
+        "name": sar.name,
+        "targets": sar.targets.tolist(),
+        "views": sar.n_views,
+        "uavs": sar.n_uavs,
+        "altitude": sar.altitude,
+        "pitch_deg": sar.pitch_deg,
+        "e_fly": sar.e_fly,
+        "e_image": sar.e_image,
+        "e_max": sar.e_max,
+    }
+
+
+def save_json(sar: SARInstance, path: str | Path) -> None:
+    Path(path).write_text(json.dumps(sar_to_dict(sar), indent=1) + "\n")
+
+
+def sar_from_dict(data, source: str = "instance") -> SARInstance:
+    """Validate a decoded JSON object and build the instance; errors name the field."""
+    if not isinstance(data, dict):
+        raise InstanceError(f"{source}: top level must be a JSON object")
+    if data.get("format") != FORMAT:
+        raise InstanceError(f"{source}: field 'format' must be {FORMAT!r}")
+    if "version" not in data:
+        raise InstanceError(f"{source}: missing field 'version'")
+    if data["version"] != FORMAT_VERSION:
+        raise InstanceError(
+            f"{source}: field 'version' is {data['version']!r}; this sarcover reads version {FORMAT_VERSION}"
+        )
+    for name in SAR_FIELDS:
+        if name not in data:
+            raise InstanceError(f"{source}: missing field '{name}'")
+    targets = data["targets"]
+    if not isinstance(targets, list) or not targets:
+        raise InstanceError(f"{source}: field 'targets' must be a non-empty list of [x, y] pairs")
+    for i, t in enumerate(targets):
+        if (
+            not isinstance(t, list)
+            or len(t) != 2
+            or not all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in t)
+        ):
+            raise InstanceError(f"{source}: field 'targets[{i}]' must be a pair of numbers, got {t!r}")
+        if not all(math.isfinite(c) for c in t):
+            raise InstanceError(f"{source}: field 'targets[{i}]' has a coordinate that is not finite")
+    for name in ("altitude", "pitch_deg", "e_fly", "e_image", "e_max"):
+        v = data[name]
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise InstanceError(f"{source}: field '{name}' must be a number, got {v!r}")
+    try:
+        return SARInstance(
+            targets=np.array(targets, dtype=float),
+            n_views=data["views"],
+            n_uavs=data["uavs"],
+            altitude=data["altitude"],
+            pitch_deg=data["pitch_deg"],
+            e_fly=data["e_fly"],
+            e_image=data["e_image"],
+            e_max=data["e_max"],
+            name=str(data.get("name", source)),
+        )
+    except InstanceError as exc:
+        raise InstanceError(f"{source}: field {exc}") from None
+
+
+def load_sar(path: str | Path) -> SARInstance:
+    path = Path(path)
+    text = _read_text(path)
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InstanceError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    return sar_from_dict(data, source=str(path))
+
+
+def read_top(path: str | Path) -> TOPInstance:
+    """Read a Chao–Golden–Wasil TOP file: E_F = 1, E_I = 0, budget tmax, Euclidean distances."""
+    path = Path(path)
+    lines = [ln.split() for ln in _read_text(path).splitlines() if ln.strip()]
+    header: dict[str, float] = {}
+    for key, row in zip(("n", "m", "tmax"), lines[:3]):
+        if len(row) != 2 or row[0] != key:
+            raise InstanceError(f"{path}: expected a '{key} <value>' line, got {' '.join(row)!r}")
+        try:
+            header[key] = float(row[1])
+        except ValueError:
+            raise InstanceError(f"{path}: '{key}' is not a number: {row[1]!r}") from None
+    if len(header) < 3:
+        raise InstanceError(f"{path}: missing the n, m, tmax header")
+    n, m = int(header["n"]), int(header["m"])
+    rows = lines[3:]
+    if n < 2 or len(rows) != n:
+        raise InstanceError(f"{path}: header says n {n} points, file has {len(rows)} point rows")
+    try:
+        pts = np.array([[float(c) for c in r[:3]] for r in rows])
+    except ValueError:
+        raise InstanceError(f"{path}: a point row is not 'x y score' numbers") from None
+    if pts.shape[1] != 3 or not np.all(np.isfinite(pts)):
+        raise InstanceError(f"{path}: every point row needs finite 'x y score'")
+    try:
+        return TOPInstance(
+            coords=pts[1:-1, :2],
+            prizes=pts[1:-1, 2],
+            start=pts[0, :2],
+            end=pts[-1, :2],
+            budget=header["tmax"],
+            n_vehicles=m,
+            e_fly=1.0,
+            e_image=0.0,
+            name=path.stem,
+            kind="top",
+        )
+    except InstanceError as exc:
+        raise InstanceError(f"{path}: {exc}") from None
+
+
+def load_instance(path: str | Path) -> TOPInstance:
+    """Load a JSON SAR instance or a TOP benchmark file into the TOP form."""
+    path = Path(path)
+    text = _read_text(path).lstrip()
+    if text.startswith("{") or path.suffix.lower() == ".json":
+        return to_top(load_sar(path))
+    if text.startswith("n"):
+        return read_top(path)
+    raise InstanceError(f"{path}: neither a sarcover JSON instance nor a TOP benchmark file")
+
+
+def _read_text(path: Path) -> str:
+    try:
+        return path.read_text()
+    except FileNotFoundError:
+        raise InstanceError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise InstanceError(f"{path}: is a directory, not an instance file") from None
+    except UnicodeDecodeError:
+        raise InstanceError(f"{path}: not a text file") from None
+    except OSError as exc:
+        raise InstanceError(f"{path}: cannot read ({exc.strerror})") from None
