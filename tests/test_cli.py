@@ -1,0 +1,82 @@
+"""The sarcover CLI end to end: generate, solve, methods, plots, and one-line errors (exit 2)."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from benchmarks.cli import main
+from conftest import TOP_DIR
+
+
+def run(*args):
+    """Run the real console entry point in a subprocess (no traceback may leak)."""
+    return subprocess.run([sys.executable, "-m", "benchmarks.cli", *args], capture_output=True, text=True)
+
+
+def test_generate_solve_json_and_plot(tmp_path):
+    """generate → solve --json → a verified greedy plan; --plot writes a PNG."""
+    inst = tmp_path / "i.json"
+    assert main(["generate", "-M", "6", "-K", "3", "-N", "2", "--seed", "4", "-o", str(inst)]) == 0
+    out = run("solve", str(inst), "--json", "--plot", str(tmp_path / "p.png"))
+    assert out.returncode == 0, out.stderr
+    rec = json.loads(out.stdout)
+    for key in ("method", "status", "objective", "bound", "coverage", "routes", "energy", "runtime_s", "valid"):
+        assert key in rec
+    assert rec["method"] == "greedy" and rec["status"] == "feasible" and rec["valid"] is True
+    assert rec["bound"] is None
+    assert rec["objective"] == sum(len(r) for r in rec["routes"])
+    assert (tmp_path / "p.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_solve_top_file_summary():
+    """A TOP benchmark file solves; the readable summary names method and objective."""
+    out = run("solve", str(TOP_DIR / "p2.2.k.txt"))
+    assert out.returncode == 0, out.stderr
+    assert "greedy (heuristic)" in out.stdout and "objective" in out.stdout
+
+
+def test_methods_lists_greedy_as_heuristic(capsys):
+    """`sarcover methods` lists greedy, marked heuristic."""
+    assert main(["methods"]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("greedy"))
+    assert "heuristic" in line
+
+
+def test_infeasible_instance_is_a_status(tmp_path):
+    """An E_max too small for any view is status infeasible with the target named, exit 0."""
+    inst = tmp_path / "i.json"
+    main(["generate", "-M", "4", "-K", "2", "-N", "1", "--e-max", "50", "-o", str(inst)])
+    out = run("solve", str(inst), "--json")
+    rec = json.loads(out.stdout)
+    assert out.returncode == 0 and rec["status"] == "infeasible" and "target 0" in rec["reason"]
+
+
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["solve", "missing.json"], "no such file"),
+        (["solve", "{inst}", "--method", "nope"], "unknown method 'nope'"),
+        (["solve", "{inst}", "--time-limit", "-3"], "--time-limit"),
+        (["solve", "{inst}", "--plot", "/no/such/dir/p.png"], "does not exist"),
+        (["solve", "{notjson}"], "not valid JSON"),
+        (["solve", "{badfield}"], "e_max"),
+        (["generate", "-M", "0", "-K", "2", "-N", "1", "-o", "x.json"], "--targets"),
+        (["generate", "-M", "3", "-K", "0", "-N", "1", "-o", "x.json"], "--views"),
+        (["generate", "-M", "3", "-K", "2", "-N", "1", "--e-max", "nan", "-o", "x.json"], "--e-max"),
+        (["frobnicate"], "invalid choice"),
+    ],
+)
+def test_bad_input_one_line_exit_2(tmp_path, args, needle):
+    """Bad input: exactly one stderr line naming the problem, exit 2, no traceback."""
+    inst = tmp_path / "i.json"
+    main(["generate", "-M", "3", "-K", "2", "-N", "1", "-o", str(inst)])
+    (tmp_path / "n.json").write_text("{oops")
+    (tmp_path / "b.json").write_text(inst.read_text().replace('"e_max"', '"e_maxx"'))
+    args = [a.format(inst=inst, notjson=tmp_path / "n.json", badfield=tmp_path / "b.json") for a in args]
+    out = subprocess.run([sys.executable, "-m", "benchmarks.cli", *args], capture_output=True, text=True,
+                         cwd=tmp_path)
+    assert out.returncode == 2
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0] and "Traceback" not in out.stderr

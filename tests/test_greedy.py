@@ -1,0 +1,31 @@
+"""`greedy` always returns verified plans, covering every target when it reports a plan."""
+
+import numpy as np
+import pytest
+
+from benchmarks.registry import run_method
+from formulations.generate import generate
+from formulations.instance import to_top
+from formulations.plan import Status
+
+
+def test_greedy_takes_everything_when_budget_allows(line_instance):
+    """Budget 6 on the line instance: all three nodes on one route."""
+    res, rep = run_method("greedy", line_instance)
+    assert res.status == Status.FEASIBLE and rep.valid and res.objective == 6.0
+
+
+@pytest.mark.parametrize("seed", range(300))
+def test_greedy_plans_always_verified(seed):
+    """Random instances, tight to loose budgets: every plan passes the verifier and covers all targets."""
+    rng = np.random.default_rng(seed)
+    m, k, n = int(rng.integers(2, 15)), int(rng.integers(1, 5)), int(rng.integers(1, 5))
+    e_max = float(rng.choice([2000, 3000, 4500, 6000, 9000]))
+    inst = to_top(generate(m, k, n, seed, e_max=e_max))
+    res, rep = run_method("greedy", inst)
+    assert res.status in (Status.FEASIBLE, Status.NO_PLAN, Status.INFEASIBLE), res.reason
+    if res.status == Status.FEASIBLE:
+        assert rep.valid and rep.groups_covered == m
+        assert res.objective == rep.covered
+    else:
+        assert res.plan is None and res.reason
