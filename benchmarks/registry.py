@@ -39,6 +39,8 @@ class MethodSpec:
 _SPECS = [
     MethodSpec("greedy", "heuristics.greedy:greedy", False,
                "cheapest insertion by prize per energy, groups first (floor baseline)"),
+    MethodSpec("cpsat", "formulations.cpsat:cpsat", True,
+               "CP-SAT routes constraint with energy variables, 1 thread; optimal only if proven unscaled"),
 ]
 
 METHODS: dict[str, MethodSpec] = {spec.name: spec for spec in _SPECS}
