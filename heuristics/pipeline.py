@@ -1,0 +1,128 @@
+"""Cluster-then-route: the paper's method family, one registered method per (clusterer, router).
+
+1. Cluster the reachable viewpoints (a viewpoint is reachable if a UAV can fly start → it → end
+   within E_max) into N = n_vehicles groups: ADPC, DPC or scikit-learn KMeans (fewer groups if
+   there are fewer viewpoints).
+2. Route each group start → group → end with a metaheuristic (PSO, GA or ACO; population 30,
+   100 iterations), all groups in one numpy batch; fitness = flight distance. Then 2-opt.
+3. Energy repair (:mod:`heuristics.repair`): drop viewpoints from over-budget tours, cover every
+   target, refill with removed viewpoints that fit.
+
+Runs are seeded (``numpy.random.default_rng(seed)``; KMeans gets ``random_state=seed``) and
+stopped by iteration counts, so the same seed gives the same plan. ``time_limit`` is a safety
+net only: when it expires the routers stop iterating and ``info["stopped_by_time"]`` is set, and
+such a run is no longer reproducible.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Callable
+
+import numpy as np
+
+from formulations.instance import TOPInstance
+from formulations.plan import Plan, Result, Status
+from heuristics.clustering import ADPC, DPC
+from heuristics.repair import RepairFailed, Repairer
+from heuristics.routing_aco import ACORouter
+from heuristics.routing_ga import GARouter
+from heuristics.routing_pso import PSORouter
+from heuristics.tour import ClusterBatch, two_opt
+
+
+def make_clusterer(kind: str, n_clusters: int, instance: TOPInstance, seed: int):
+    """A fresh scikit-learn-style clusterer: 'adpc', 'dpc' or 'kmeans'."""
+    if kind == "adpc":
+        return ADPC(n_clusters, base=instance.start)
+    if kind == "dpc":
+        return DPC(n_clusters)
+    if kind == "kmeans":
+        from sklearn.cluster import KMeans
+
+        return KMeans(n_clusters=n_clusters, n_init=1, random_state=seed)
+    raise ValueError(f"unknown clusterer {kind!r}")
+
+
+ROUTERS: dict[str, Callable[[], object]] = {"pso": PSORouter, "ga": GARouter, "aco": ACORouter}
+
+
+def cluster_then_route(
+    instance: TOPInstance,
+    clusterer: str,
+    router: str,
+    *,
+    seed: int = 0,
+    time_limit: float | None = None,
+    reinsert: bool = True,
+    name: str | None = None,
+) -> Result:
+    """Run the pipeline and return a Result (FEASIBLE with a plan, or NO_PLAN with a reason)."""
+    t0 = time.perf_counter()
+    name = name or f"{clusterer}-{router}"
+    deadline = None if time_limit is None else t0 + float(time_limit)
+    rng = np.random.default_rng(seed)
+    reach = np.flatnonzero(instance.reachable())  # node ids
+    info: dict = {"clusterer": clusterer, "router": router}
+    if reach.size == 0:
+        if instance.groups:
+            return Result(name, Status.NO_PLAN, reason="no viewpoint is reachable within E_max",
+                          runtime_s=time.perf_counter() - t0, info=info)
+        empty = Plan.of([[] for _ in range(instance.n_vehicles)])
+        return Result(name, Status.FEASIBLE, plan=empty, runtime_s=time.perf_counter() - t0, info=info)
+
+    k = min(instance.n_vehicles, reach.size)
+    labels = make_clusterer(clusterer, k, instance, seed).fit(instance.coords[reach]).labels_
+    clusters = [reach[labels == c] + 1 for c in range(k)]  # solver indices
+    info["cluster_sizes"] = [int(c.size) for c in clusters]
+    t1 = time.perf_counter()
+
+    D = instance.distance_matrix()
+    end = instance.n_nodes + 1
+    batch = ClusterBatch.of(clusters, 0, end)
+    if batch.which.size:
+        best, _ = ROUTERS[router]().solve(D, batch, rng, deadline)
+        tours = batch.routes(clusters, best)
+    else:
+        tours = clusters
+    tours = [two_opt(D, t, 0, end).tolist() for t in tours]
+    info["stopped_by_time"] = bool(deadline is not None and time.perf_counter() > deadline)
+    t2 = time.perf_counter()
+
+    repairer = Repairer(instance, D=D)
+    try:
+        routes = repairer.repair(tours, reinsert=reinsert)
+    except RepairFailed as exc:
+        info.update(repairer.stats)
+        return Result(name, Status.NO_PLAN, reason=str(exc), runtime_s=time.perf_counter() - t0, info=info)
+    t3 = time.perf_counter()
+    info.update(repairer.stats)
+    info["time_cluster_s"], info["time_route_s"], info["time_repair_s"] = t1 - t0, t2 - t1, t3 - t2
+    routes = [[v - 1 for v in r] for r in routes]
+    routes += [[] for _ in range(instance.n_vehicles - len(routes))]
+    return Result(name, Status.FEASIBLE, plan=Plan.of(routes), runtime_s=time.perf_counter() - t0, info=info)
+
+
+def adpc_pso(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:
+    """The paper's method: ADPC clusters, random-key PSO tours, energy repair."""
+    return cluster_then_route(instance, "adpc", "pso", seed=seed, time_limit=time_limit)
+
+
+def dpc_pso(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:
+    """DPC clusters (nearest-denser assignment), PSO tours, energy repair."""
+    return cluster_then_route(instance, "dpc", "pso", seed=seed, time_limit=time_limit)
+
+
+def kmeans_pso(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:
+    """scikit-learn KMeans clusters, PSO tours, energy repair."""
+    return cluster_then_route(instance, "kmeans", "pso", seed=seed, time_limit=time_limit)
+
+
+def adpc_ga(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:
+    """ADPC clusters, GA tours (OX, inversion mutation, elitism), energy repair."""
+    return cluster_then_route(instance, "adpc", "ga", seed=seed, time_limit=time_limit)
+
+
+def adpc_aco(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:
+    """ADPC clusters, elitist ant system tours, energy repair."""
+    return cluster_then_route(instance, "adpc", "aco", seed=seed, time_limit=time_limit)

@@ -1,0 +1,97 @@
+"""Ant system (Dorigo, Maniezzo & Colorni 1996) with an elitist ant, for each cluster's tour order.
+
+Each ant builds a tour from the start: at every step it moves to an unvisited viewpoint j with
+probability ∝ τ_ij^α·η_ij^β, η = 1/distance. After all ants are built, pheromone evaporates,
+τ ← (1-ρ)·τ, and every ant deposits 1/length on its arcs; the best tour so far deposits an extra
+``elitist``/length (Dorigo's elitist ant system). τ starts uniform at P / L₀, L₀ the best length of
+the first colony, so deposits and τ are on one scale. The return arc to the end point is fixed
+and carries no pheromone.
+
+Vectorised over ants and clusters at once: the colony is (B, P) ants, a step draws every ant's
+next viewpoint with the Gumbel-max trick (argmax of log-weight + Gumbel noise, which samples the
+same distribution as a roulette wheel) and deposits use one ``np.bincount``. The only Python loop
+is over the L construction steps.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from heuristics.tour import ClusterBatch
+
+_PAD = -1e300  # log-weight of a pad: chosen only once every real viewpoint is visited
+
+
+class ACORouter:
+    """Elitist ant system: ``n_ants`` ants, ``n_iterations`` colonies."""
+
+    name = "aco"
+
+    def __init__(
+        self,
+        n_ants: int = 30,
+        n_iterations: int = 100,
+        *,
+        alpha: float = 1.0,
+        beta: float = 3.0,
+        rho: float = 0.5,
+        elitist: float = 5.0,
+    ):
+        self.n_ants = n_ants
+        self.n_iterations = n_iterations
+        self.alpha, self.beta, self.rho, self.elitist = alpha, beta, rho, elitist
+
+    def solve(self, D: np.ndarray, batch: ClusterBatch, rng: np.random.Generator, deadline=None):
+        """Best local order (B, L) per cluster row and its length (B,); pads at the tail."""
+        B, L = batch.nodes.shape
+        P = self.n_ants
+        pad = batch.pad  # (B, L)
+        # state L is the start; states 0..L-1 are local positions
+        src = np.concatenate([batch.nodes, np.full((B, 1), batch.start)], axis=1)  # (B, L+1)
+        dist = D[src[:, :, None], batch.nodes[:, None, :]]  # (B, L+1, L)
+        log_eta = -self.beta * np.log(np.maximum(dist, 1e-9))
+        log_eta = np.where(pad[:, None, :], _PAD, log_eta)
+        tau = np.ones((B, L + 1, L))
+        b_idx = np.arange(B)[:, None]
+        flat_base = (np.arange(B) * (L + 1) * L)[:, None, None]
+        best_f = np.full(B, np.inf)
+        best = np.tile(np.arange(L), (B, 1))
+        for it in range(self.n_iterations):
+            if deadline is not None and time.perf_counter() > deadline:
+                break
+            logw = self.alpha * np.log(tau) + log_eta  # (B, L+1, L)
+            noise = rng.gumbel(size=(L, B, P, L))
+            visited = np.zeros((B, P, L))  # 0 or -inf, added to the log-weights
+            cur = np.full((B, P), L)
+            tours = np.empty((B, P, L), dtype=int)
+            for s in range(L):
+                nxt = np.argmax(logw[b_idx, cur] + visited + noise[s], axis=-1)
+                tours[:, :, s] = nxt
+                np.put_along_axis(visited, nxt[..., None], -np.inf, axis=-1)
+                cur = nxt
+            f = batch.lengths(D, tours)
+            k = np.argmin(f, axis=1)
+            fk = f[np.arange(B), k]
+            improved = fk < best_f
+            best = np.where(improved[:, None], tours[np.arange(B), k], best)
+            best_f = np.minimum(fk, best_f)
+            if it == 0:
+                tau = np.broadcast_to((P / best_f)[:, None, None], tau.shape).copy()
+            prev = np.concatenate([np.full((B, P, 1), L), tours[:, :, :-1]], axis=-1)
+            real = ~np.take_along_axis(np.broadcast_to(pad[:, None, :], tours.shape), tours, -1)
+            idx = flat_base + prev * L + tours  # (B, P, L)
+            w = np.broadcast_to((1.0 / f)[..., None], idx.shape)
+            bprev = np.concatenate([np.full((B, 1), L), best[:, :-1]], axis=-1)
+            bidx = (np.arange(B) * (L + 1) * L)[:, None] + bprev * L + best
+            breal = ~np.take_along_axis(pad, best, -1)
+            bw = np.broadcast_to((self.elitist / best_f)[:, None], bidx.shape)
+            deposit = np.bincount(
+                np.concatenate([idx[real], bidx[breal]]),
+                weights=np.concatenate([w[real], bw[breal]]),
+                minlength=B * (L + 1) * L,
+            ).reshape(B, L + 1, L)
+            tau = (1.0 - self.rho) * tau + deposit
+            np.maximum(tau, 1e-300, out=tau)
+        return best, best_f
