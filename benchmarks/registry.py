@@ -39,6 +39,16 @@ class MethodSpec:
 _SPECS = [
     MethodSpec("greedy", "heuristics.greedy:greedy", False,
                "cheapest insertion by prize per energy, groups first (floor baseline)"),
+    MethodSpec("adpc-pso", "heuristics.pipeline:adpc_pso", False,
+               "the paper's: ADPC clusters, random-key PSO tours (+2-opt), energy repair and refill"),
+    MethodSpec("dpc-pso", "heuristics.pipeline:dpc_pso", False,
+               "DPC clusters, random-key PSO tours (+2-opt), energy repair and refill"),
+    MethodSpec("kmeans-pso", "heuristics.pipeline:kmeans_pso", False,
+               "scikit-learn KMeans clusters, random-key PSO tours (+2-opt), energy repair and refill"),
+    MethodSpec("adpc-ga", "heuristics.pipeline:adpc_ga", False,
+               "ADPC clusters, GA tours (OX, inversion, elitism; +2-opt), energy repair and refill"),
+    MethodSpec("adpc-aco", "heuristics.pipeline:adpc_aco", False,
+               "ADPC clusters, elitist ant system tours (+2-opt), energy repair and refill"),
     MethodSpec("cpsat", "formulations.cpsat:cpsat", True,
                "CP-SAT routes constraint with energy variables, 1 thread; optimal only if proven unscaled"),
 ]
