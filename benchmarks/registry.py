@@ -51,6 +51,10 @@ _SPECS = [
                "ADPC clusters, elitist ant system tours (+2-opt), energy repair and refill"),
     MethodSpec("cpsat", "formulations.cpsat:cpsat", True,
                "CP-SAT routes constraint with energy variables, 1 thread; optimal only if proven unscaled"),
+    MethodSpec("routing", "heuristics.routing_method:routing", False,
+               "OR-Tools routing, prize disjunctions + energy dimension, guided local search, <=10 s"),
+    MethodSpec("pyvrp", "heuristics.pyvrp_method:pyvrp", False,
+               "PyVRP iterated local search, optional clients with prizes, max distance = energy, 2000 its"),
 ]
 
 METHODS: dict[str, MethodSpec] = {spec.name: spec for spec in _SPECS}

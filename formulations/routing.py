@@ -1,0 +1,189 @@
+"""The OR-Tools routing solver on the TOP form (a heuristic: no bound).
+
+The registered method `routing` (:mod:`heuristics.routing_method`) calls :func:`solve_routing`,
+falling back to a greedy warm start when the cold search leaves a group uncovered.
+
+Model (the sequence of the OR-Tools samples: build, set limits and strategy, solve, extract):
+
+- locations: 0 = start, 1..k = the k useful nodes (reachable alone within the budget, and with a
+  prize or in a group), k+1 = end; one vehicle per UAV with ``starts=[0]*N``, ``ends=[k+1]*N``,
+  so distinct start and end depots need nothing special.
+- an ``energy`` dimension with the integer arc energies of :mod:`formulations.scaling`
+  (``ceil(scale*c_ij)``, capacity ``floor(scale*E_max)``): any plan the solver accepts is within
+  the true budget. The start → end arc is 0 (an empty route costs nothing).
+- one disjunction per node, penalty = its prize scaled so that the smallest prize outweighs any
+  plan's total travel cost: collecting prize comes first, travel (the arc cost, energy scaled to
+  1000 units per E_max) only breaks ties.
+- groups ("at least one node of each group"): OR-Tools has no "at least one" disjunction (a
+  penalised disjunction bounds the active count from above). A side constraint
+  ``sum(ActiveVar) >= 1`` is accepted by the CP solver, but then no first-solution strategy
+  finds a plan (tried: path cheapest arc, savings, local cheapest insertion). Instead every
+  group node v gets a cover copy at the same place: the disjunction {v, copy(v)} (at most one
+  active, penalty prize_v if neither) keeps prizes exact and forbids double visits, and the
+  mandatory disjunction {copies of group g} (exactly one) forces the cover. A node may belong
+  to several disjunctions in OR-Tools.
+  The group disjunction is soft with a penalty above all prizes and travel together (a
+  mandatory one made every first-solution strategy fail on tight SAR budgets); a plan that
+  still leaves a group uncovered comes back as NO_PLAN.
+- search: local cheapest insertion (or the given warm start), then guided local search,
+  single-threaded. It stops at ``time_limit`` or after ``solution_limit`` solutions,
+  whichever comes first. A run stopped by the solution limit is deterministic; one stopped by
+  time is not (``info["stopped_by"]`` says which).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from ortools.constraint_solver import pywrapcp, routing_enums_pb2
+
+from formulations.instance import TOPInstance
+from formulations.plan import Plan, Result, Status
+from formulations.scaling import integer_prizes, scaled_costs
+from formulations.verify import verify
+
+DEFAULT_TIME_CAP = 10.0  # seconds, when no time limit is given
+SOLUTION_LIMIT = 1000  # local-search solutions; the reproducible stop (~1-10 s at 60 nodes)
+TIEBREAK_UNITS = 1000  # travel cost units per E_max in the objective (tie-break only)
+
+
+def _useful_nodes(instance: TOPInstance) -> np.ndarray:
+    """Node ids worth modelling: reachable alone, with a prize or belonging to a group."""
+    keep = instance.reachable() & ((instance.prizes > 0) | (instance.group_of >= 0))
+    return np.flatnonzero(keep)
+
+
+def solve_routing(
+    instance: TOPInstance,
+    *,
+    seed: int = 0,
+    time_limit: float | None = 60.0,
+    initial_routes: list[list[int]] | None = None,
+    solution_limit: int = SOLUTION_LIMIT,
+) -> Result:
+    """Prize-collecting TOP by OR-Tools routing with guided local search.
+
+    ``seed`` is unused (OR-Tools routing has no seed; the search is deterministic when stopped
+    by ``solution_limit``). ``initial_routes`` (node ids, e.g. a greedy plan) warm-starts the
+    search; if the integer model rejects them (a route within rounding of the budget) the
+    search starts from local cheapest insertion instead (``info["warm_start"]`` says which).
+"""
+    t0 = time.perf_counter()
+    cap = DEFAULT_TIME_CAP if time_limit is None else float(time_limit)
+    nodes = _useful_nodes(instance)
+    k, n_veh = len(nodes), instance.n_vehicles
+    if k == 0:
+        if instance.groups:
+            return Result("routing", Status.NO_PLAN, reason="no group node is reachable",
+                          runtime_s=time.perf_counter() - t0)
+        return Result("routing", Status.FEASIBLE, plan=Plan.of([[] for _ in range(n_veh)]),
+                      runtime_s=time.perf_counter() - t0, info={"stopped_by": "trivial"})
+
+    # Groups: every group node v gets a "cover copy" at the same place. Disjunction {v, copy}
+    # (at most one active, penalty prize_v if neither) keeps v's prize exact and forbids a
+    # double visit; disjunction {copies of group g} with a negative penalty makes exactly one
+    # copy per group mandatory. That is "at least one node per group" without side constraints.
+    pos = {int(v): i + 1 for i, v in enumerate(nodes)}
+    copies: list[int] = []  # node id of each cover copy, in model order after the originals
+    group_locs: list[list[int]] = []
+    for gi, group in enumerate(instance.groups):
+        locs = []
+        for v in group:
+            if v in pos:
+                copies.append(int(v))
+                locs.append(k + len(copies))
+        if not locs:
+            return Result("routing", Status.NO_PLAN, reason=f"group {gi} has no reachable node",
+                          runtime_s=time.perf_counter() - t0)
+        group_locs.append(locs)
+    model_nodes = np.concatenate([nodes, np.asarray(copies, dtype=int)]).astype(int)  # model loc - 1 -> node id
+    n_loc = len(model_nodes) + 2
+
+    sc = scaled_costs(instance)
+    sel = np.concatenate([[0], model_nodes + 1, [instance.n_nodes + 1]])  # model order -> solver order
+    energy = sc.arc[np.ix_(sel, sel)]
+    # tie-break travel cost: TIEBREAK_UNITS per E_max, rounded up, start→end arc 0 like energy
+    travel = np.ceil(instance.cost_matrix()[np.ix_(sel, sel)] * (TIEBREAK_UNITS / max(instance.budget, 1e-300)))
+    travel = np.minimum(travel, 10 * TIEBREAK_UNITS).astype(np.int64)  # arcs beyond the budget never fit
+    np.fill_diagonal(travel, 0)
+    travel[0, -1] = 0
+    max_travel = n_veh * (TIEBREAK_UNITS + len(model_nodes) + 2)  # above any feasible plan's travel cost
+    penalty = integer_prizes(instance.prizes[nodes], max_travel)
+
+    manager = pywrapcp.RoutingIndexManager(n_loc, n_veh, [0] * n_veh, [n_loc - 1] * n_veh)
+    model = pywrapcp.RoutingModel(manager)
+    energy_cb = model.RegisterTransitMatrix(energy.tolist())
+    travel_cb = model.RegisterTransitMatrix(travel.tolist())
+    model.SetArcCostEvaluatorOfAllVehicles(travel_cb)
+    model.AddDimension(energy_cb, 0, sc.budget, True, "energy")
+    copy_of = {v: k + 1 + i for i, v in enumerate(copies)}
+    for loc in range(1, k + 1):
+        members = [loc] + ([copy_of[int(nodes[loc - 1])]] if int(nodes[loc - 1]) in copy_of else [])
+        model.AddDisjunction([manager.NodeToIndex(l) for l in members], int(penalty[loc - 1]), 1)
+    group_penalty = int(penalty.sum()) + max_travel + 1  # one uncovered group outweighs everything else
+    for locs in group_locs:
+        model.AddDisjunction([manager.NodeToIndex(l) for l in locs], group_penalty, 1)
+
+    params = pywrapcp.DefaultRoutingSearchParameters()
+    params.first_solution_strategy = routing_enums_pb2.FirstSolutionStrategy.LOCAL_CHEAPEST_INSERTION
+    params.local_search_metaheuristic = routing_enums_pb2.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH
+    remaining = max(cap - (time.perf_counter() - t0), 0.01)
+    params.time_limit.FromMilliseconds(max(int(remaining * 1000), 10))
+    params.log_search = False
+
+    params.solution_limit = solution_limit
+    warm = None
+    if initial_routes is not None:
+        covered: set[int] = set()
+        loc_routes = []
+        for route in initial_routes:
+            locs = []
+            for v in route:
+                gi = int(instance.group_of[v])
+                if gi >= 0 and gi not in covered and int(v) in copy_of:
+                    covered.add(gi)
+                    locs.append(copy_of[int(v)])  # the group's cover copy
+                elif int(v) in pos:
+                    locs.append(pos[int(v)])
+            loc_routes.append([manager.NodeToIndex(l) for l in locs])
+        model.CloseModelWithParameters(params)
+        warm = model.ReadAssignmentFromRoutes(loc_routes, True)
+    t_solve = time.perf_counter()
+    if warm is not None:
+        solution = model.SolveFromAssignmentWithParameters(warm, params)
+    else:
+        solution = model.SolveWithParameters(params)
+    solve_s = time.perf_counter() - t_solve
+    info = {"scale": sc.scale, "nodes_modelled": k, "time_cap_s": cap, "solver_status": int(model.status()),
+            "warm_start": warm is not None}
+    if solution is None:
+        what = "target" if instance.kind == "sar" else "group"
+        reason = (f"OR-Tools routing found no plan covering every {what} in {solve_s:.3g} s"
+                  if instance.groups else "OR-Tools routing found no solution")
+        return Result("routing", Status.NO_PLAN, reason=reason, runtime_s=time.perf_counter() - t0, info=info)
+
+    routes = []
+    for veh in range(n_veh):
+        idx, route = model.Start(veh), []
+        idx = solution.Value(model.NextVar(idx))
+        while not model.IsEnd(idx):
+            route.append(int(model_nodes[manager.IndexToNode(idx) - 1]))
+            idx = solution.Value(model.NextVar(idx))
+        routes.append(route)
+    plan = Plan.of(routes)
+    visited = {v for r in routes for v in r}
+    uncovered = [gi for gi, g in enumerate(instance.groups) if not visited.intersection(g)]
+    if uncovered:
+        what = "target" if instance.kind == "sar" else "group"
+        info["uncovered"] = uncovered
+        return Result("routing", Status.NO_PLAN, runtime_s=time.perf_counter() - t0, info=info,
+                      reason=f"OR-Tools routing left {len(uncovered)} {what}(s) uncovered, e.g. {what} {uncovered[0]}")
+    info["stopped_by"] = "time" if solve_s >= remaining * 0.98 else "solution_limit"
+    info["objective_int"] = int(solution.ObjectiveValue())
+    report = verify(instance, plan)  # the integer model rounds up; this must never fail
+    if not report.valid:
+        return Result("routing", Status.ERROR, plan=plan, runtime_s=time.perf_counter() - t0,
+                      reason="routing plan failed verification: " + "; ".join(report.violations[:3]), info=info)
+    return Result("routing", Status.FEASIBLE, plan=plan, runtime_s=time.perf_counter() - t0, info=info)
