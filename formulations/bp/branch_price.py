@@ -1,0 +1,328 @@
+"""Branch-and-price for the team orienteering problem with group cover: the ``bp`` method.
+
+Each branch-and-bound node runs column generation on the route master (:mod:`.master`) with the
+labelling pricing (:mod:`.pricing`):
+
+1. heuristic pricing (dominance without visited sets) until it finds no improving route;
+2. exact pricing over ng-routes (a relaxation of elementary routes): its best reduced prize gives
+   the certified Lagrangian bound of the round; improving elementary routes become columns; if
+   only non-elementary ng-paths improve, the ng sets grow along their cycles and pricing repeats
+   (decremental state space relaxation). The node is solved when exact pricing finds nothing
+   above the vehicle dual.
+
+Branching, in order: on a fractional node visit (forbid the node / force it visited: a forced node
+row becomes ``= 1``); then, when all visits are integral, on a fractional arc flow (forbid the arc
+/ force it: the tail may only go to the head and the head may only be reached from the tail).
+Both keep the pricing a plain labelling on a modified graph. With integral visits and arc flows the
+LP solution is integral (each positive route follows the unique flow-1 arcs). Nodes are explored
+best-bound first; a node is pruned when its bound, rounded down to the prize lattice when all
+prizes are integers, does not exceed the incumbent. Incumbents come from integral LP solutions and
+from a MILP over the generated routes (HiGHS), run at the root and periodically.
+
+The reported bound is max(incumbent, bounds of the open nodes), certified at every stop.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from formulations.bp.master import Master
+from formulations.bp.pricing import add_to_ng, cheapest_return, full_ng, nearest_ng, price
+from formulations.instance import TOPInstance, precheck
+from formulations.plan import Plan, Result, Status
+from formulations.verify import verify
+
+TOL = 1e-6
+
+
+@dataclass(frozen=True)
+class NodeState:
+    """Branching decisions of one branch-and-bound node (solver points: node id + 1)."""
+
+    forbidden_nodes: frozenset = frozenset()
+    forced_nodes: frozenset = frozenset()
+    forbidden_arcs: frozenset = frozenset()
+    forced_arcs: frozenset = frozenset()
+    depth: int = 0
+
+    def child(self, **add) -> "NodeState":
+        kw = {k: getattr(self, k) | frozenset(add.get(k, ())) for k in
+              ("forbidden_nodes", "forced_nodes", "forbidden_arcs", "forced_arcs")}
+        return NodeState(**kw, depth=self.depth + 1)
+
+
+@dataclass
+class _Stats:
+    rounds: int = 0
+    exact_pricings: int = 0
+    labels: int = 0
+    ng_growths: int = 0
+    nodes: int = 0
+    milp_calls: int = 0
+    pricing_s: float = 0.0
+    lp_s: float = 0.0
+    root_bound: float | None = None
+    root_s: float | None = None
+    history: list = field(default_factory=list)  # (time, incumbent, bound)
+
+
+class BranchAndPrice:
+    def __init__(self, instance: TOPInstance, *, time_limit: float | None, ng_size: int = 12,
+                 initial_routes=None):
+        self.inst = instance
+        self.t0 = time.perf_counter()
+        limit = float(time_limit) if time_limit is not None else math.inf
+        self.hard_deadline = self.t0 + limit
+        self.reserve = min(5.0, 0.1 * limit)  # kept for a last MILP over the generated routes
+        self.deadline = self.hard_deadline - self.reserve
+        self.V = instance.n_nodes
+        self.N = instance.n_vehicles
+        self.cost = instance.cost_matrix()
+        self.budget = instance.budget * (1.0 + 1e-9)
+        self.integral = bool(np.all(instance.prizes == np.round(instance.prizes)))
+        trip = self.cost[0, 1 : self.V + 1] + self.cost[1 : self.V + 1, self.V + 1]
+        self.reachable = np.zeros(self.V + 2, dtype=bool)
+        self.reachable[1 : self.V + 1] = trip <= self.budget
+        self.master = Master(self.V, instance.prizes, instance.groups, self.N)
+        n = self.V + 2
+        self.ng = full_ng(n) if ng_size >= self.V else nearest_ng(self.cost, ng_size)
+        self.stats = _Stats()
+        self.incumbent_value = 0.0 if not instance.groups else -math.inf
+        self.incumbent: list[tuple[int, ...]] | None = [] if not instance.groups else None
+        cols = [(int(p),) for p in np.flatnonzero(self.reachable)]
+        for r in initial_routes or ():
+            pts = tuple(int(v) + 1 for v in r)
+            if pts and self._energy(pts) <= self.budget:
+                cols.append(pts)
+        self.master.add_routes(cols)
+        if initial_routes:
+            self._offer([tuple(int(v) + 1 for v in r) for r in initial_routes if r])
+
+    # -- helpers ---------------------------------------------------------------------------
+    def _energy(self, pts) -> float:
+        full = [0, *pts, self.V + 1]
+        return float(sum(self.cost[a, b] for a, b in zip(full, full[1:])))
+
+    def _time_left(self) -> float:
+        return self.deadline - time.perf_counter()
+
+    def _floor(self, bound: float) -> float:
+        return math.floor(bound + 1e-6) if self.integral else bound
+
+    def _offer(self, routes) -> None:
+        """Accept a plan (solver points) as incumbent if the verifier agrees and it is better."""
+        if routes is None or len(routes) > self.N:
+            return
+        plan = Plan.of([[p - 1 for p in r] for r in routes])
+        rep = verify(self.inst, plan)
+        if rep.valid and rep.prize > self.incumbent_value + 1e-9:
+            self.incumbent_value = rep.prize
+            self.incumbent = list(routes)
+            self._log()
+
+    def _log(self, bound: float | None = None) -> None:
+        inc = None if self.incumbent is None else self.incumbent_value
+        self.stats.history.append((round(time.perf_counter() - self.t0, 4), inc, bound))
+
+    def _prunable(self, bound: float) -> bool:
+        b = self._floor(bound)
+        if self.incumbent is None:
+            return b < -TOL  # no plan (prize >= 0) exists below this node
+        return b <= self.incumbent_value + TOL
+
+    # -- column generation at one node -----------------------------------------------------
+    def _node_graph(self, state: NodeState):
+        cost = self.cost.copy()
+        n = self.V + 2
+        end = n - 1
+        for a, b in state.forbidden_arcs:
+            cost[a, b] = np.inf
+        for a, b in state.forced_arcs:
+            if a != 0:
+                keep = cost[a, b]
+                cost[a, :] = np.inf
+                cost[a, b] = keep
+            if b != end:
+                keep = cost[a, b]
+                cost[:, b] = np.inf
+                cost[a, b] = keep
+        allowed = self.reachable.copy()
+        for p in state.forbidden_nodes:
+            allowed[p] = False
+        return cost, cheapest_return(cost), allowed
+
+    def _price(self, cost, ret, prof, allowed, *, heuristic, y0):
+        t = time.perf_counter()
+        res = price(cost, ret, prof, self.budget, self.ng, allowed, heuristic=heuristic,
+                    max_labels=200_000 if heuristic else 2_000_000, n_cols=30 if heuristic else 60,
+                    min_gain=y0 + TOL, deadline=self.deadline)
+        self.stats.pricing_s += time.perf_counter() - t
+        self.stats.labels += res.n_labels
+        return res
+
+    def column_generation(self, state: NodeState, bound: float):
+        """Solve one node's LP by column generation. Returns (bound, x, x_art, converged)."""
+        m = self.master
+        m.apply(state)
+        cost, ret, allowed_base = self._node_graph(state)
+        arcs_decided = bool(state.forbidden_arcs or state.forced_arcs)
+        x = xa = None
+        while True:
+            t = time.perf_counter()
+            value, x, xa, y = m.solve()
+            self.stats.lp_s += time.perf_counter() - t
+            self.stats.rounds += 1
+            if self._time_left() <= 0:
+                return bound, x, xa, False
+            prof = m.point_profit(y)
+            allowed = allowed_base.copy()
+            if not arcs_decided:
+                # With the triangle inequality a node of reduced prize <= 0 can be skipped.
+                allowed &= prof > 1e-12
+            y0 = float(y[0])
+            res = self._price(cost, ret, prof, allowed, heuristic=True, y0=y0)
+            if res.routes and m.add_routes(res.routes):
+                continue
+            if self._time_left() <= 0:
+                return bound, x, xa, False
+            res = self._price(cost, ret, prof, allowed, heuristic=False, y0=y0)
+            self.stats.exact_pricings += 1
+            if res.exact:
+                bound = min(bound, m.lagrangian_bound(y, res.best))
+                if state.depth == 0:
+                    self._log(bound)
+            if res.routes and m.add_routes(res.routes):
+                continue
+            if res.best - y0 > TOL and res.cycles:
+                for cyc in res.cycles:  # cycle u ... u: remember u at every node of the cycle
+                    u = cyc[0]
+                    for w in cyc[1:-1]:
+                        add_to_ng(self.ng, w, u)
+                self.stats.ng_growths += 1
+                continue
+            if not res.exact:
+                return bound, x, xa, False
+            return bound, x, xa, True
+
+    # -- branch and bound ------------------------------------------------------------------
+    def _branch(self, state: NodeState, x: np.ndarray):
+        m = self.master
+        visits = m.node_visits(x)[1 : self.V + 1]
+        frac = np.abs(visits - np.round(visits))
+        if frac.max() > TOL:
+            p = int(np.argmax(-np.abs(visits - 0.5) + (frac <= TOL) * -10.0)) + 1
+            return [state.child(forced_nodes=[p]), state.child(forbidden_nodes=[p])]
+        flows = m.arc_flows(x)
+        best, arc = TOL, None
+        for a, f in flows.items():
+            d = abs(f - round(f))
+            if d > best and min(f, 1 - f) > TOL:
+                best, arc = d, a
+        if arc is None:
+            return None
+        return [state.child(forced_arcs=[arc]), state.child(forbidden_arcs=[arc])]
+
+    def _run_milp(self, limit: float) -> None:
+        self.stats.milp_calls += 1
+        limit = min(limit, max(0.0, self.hard_deadline - time.perf_counter() - 0.1))
+        if limit > 0.05:
+            self._offer(self.master.milp(limit))
+
+    def run(self):
+        root = NodeState()
+        trivial = float(self.inst.prizes[self.reachable[1 : self.V + 1]].sum())
+        heap = [(-trivial, 0, 0, root)]
+        counter = 1
+        open_bound = math.inf
+        unresolved = []  # nodes we cannot split further (should not happen) with their bounds
+        last_milp_cols = 0
+        proven = False
+        while heap:
+            if self._time_left() <= 0:
+                break
+            negb, _, _, state = heapq.heappop(heap)
+            parent_bound = -negb
+            if self._prunable(parent_bound):
+                continue
+            self.stats.nodes += 1
+            bound, x, xa, converged = self.column_generation(state, parent_bound)
+            if state.depth == 0:
+                self.stats.root_bound = bound if math.isfinite(bound) else None
+                self.stats.root_s = time.perf_counter() - self.t0
+                if self._time_left() > 0:
+                    self._run_milp(min(10.0, 0.25 * self._time_left()))
+                    last_milp_cols = self.master.n_routes
+            if not converged:
+                heapq.heappush(heap, (-bound, -state.depth, counter, state))
+                counter += 1
+                break
+            if self._prunable(bound):
+                continue
+            if xa.max() <= TOL and np.all(np.abs(x - np.round(x)) <= TOL):
+                self._offer([self.master.routes[r] for r in np.flatnonzero(x > 0.5)])
+                continue
+            children = self._branch(state, x)
+            if children is None:
+                unresolved.append(bound)
+                continue
+            for ch in children:
+                heapq.heappush(heap, (-bound, -ch.depth, counter, ch))
+                counter += 1
+            if self.stats.nodes % 25 == 0 and self.master.n_routes > last_milp_cols:
+                self._run_milp(min(5.0, 0.1 * max(self._time_left(), 0.0)))
+                last_milp_cols = self.master.n_routes
+        else:
+            proven = not unresolved
+        if not proven and self.master.n_routes:
+            self._run_milp(max(0.0, self.hard_deadline - time.perf_counter() - 0.1))
+        open_bounds = [-nb for nb, *_ in heap] + unresolved
+        inc = self.incumbent_value if self.incumbent is not None else -math.inf
+        if open_bounds:
+            open_bound = max(self._floor(b) for b in open_bounds)
+            bound = max(inc, open_bound)
+        else:
+            bound = inc
+        return proven, bound
+
+
+def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
+             initial_routes=None, ng_size: int = 12) -> Result:
+    """Branch-and-price: proven optimum, or the best plan and a certified bound at the limit.
+
+    ``initial_routes`` (node ids, e.g. a heuristic plan's routes) are added as starting columns
+    and as a first incumbent. ``seed`` is unused (the method is deterministic).
+    """
+    t0 = time.perf_counter()
+    reason = precheck(instance)
+    if reason is not None:
+        return Result("bp", Status.INFEASIBLE, reason=reason, runtime_s=time.perf_counter() - t0)
+    bp = BranchAndPrice(instance, time_limit=time_limit, ng_size=ng_size,
+                        initial_routes=initial_routes)
+    proven, bound = bp.run()
+    st = bp.stats
+    info = {
+        "nodes": st.nodes, "rounds": st.rounds, "columns": bp.master.n_routes,
+        "exact_pricings": st.exact_pricings, "labels": st.labels, "ng_growths": st.ng_growths,
+        "milp_calls": st.milp_calls, "pricing_s": round(st.pricing_s, 3), "lp_s": round(st.lp_s, 3),
+        "root_bound": st.root_bound, "root_s": st.root_s, "history": st.history, "threads": 1,
+    }
+    runtime = time.perf_counter() - t0
+    plan = None if bp.incumbent is None else Plan.of([[p - 1 for p in r] for r in bp.incumbent])
+    if plan is None:
+        if proven:
+            return Result("bp", Status.INFEASIBLE, bound=None, runtime_s=runtime, info=info,
+                          reason="branch-and-price proved that no plan covers every group")
+        b = bound if math.isfinite(bound) else None
+        return Result("bp", Status.TIME_LIMIT, bound=b, runtime_s=runtime, info=info,
+                      reason="time limit before a plan covering every group was found")
+    if proven:
+        return Result("bp", Status.OPTIMAL, plan=plan, bound=bp.incumbent_value, runtime_s=runtime,
+                      info=info)
+    b = bound if math.isfinite(bound) else None
+    return Result("bp", Status.TIME_LIMIT, plan=plan, bound=b, runtime_s=runtime, info=info,
+                  reason="time limit")

@@ -1,0 +1,234 @@
+"""The route master (set packing with group cover) on HiGHS, and its certified Lagrangian bound.
+
+Rows (solver order, point p = node id + 1)::
+
+    row 0            sum_r x_r                 <= N     (vehicles)
+    row p, p=1..V    sum_r a_pr x_r            <= 1     (each node at most once; = 1 when forced)
+    row V+1+g        sum_r sum_{p in g} a_pr x_r >= 1   (group g covered)
+
+The group row counts visits (a route through two nodes of one group counts 2). For integer x this
+is the same constraint as "some chosen route covers g" because each node is visited at most once
+overall; in the LP it keeps the pricing linear (each node carries its group's dual).
+
+Columns: one artificial per node row and per group row (coefficient +1, prize -BIG: Phase I, so
+that the LP is always feasible, including under "node forced" branches), then the routes.
+
+Bound (every round, any duals y with the right signs): for every x feasible in the full master
+(all routes allowed at the branch-and-bound node, no artificials),
+``prize·x = sum_r rc_r x_r + y·(A x) <= N·max(0, rc*) + sum_k (y_k U_k if y_k > 0 else y_k L_k)``
+with rc_r = p_r - A_r·y (HiGHS's convention) and rc* the best reduced prize over all allowed
+routes (from exact pricing, or any upper bound on it such as ng-route pricing), since
+sum_r x_r <= N and L <= A x <= U. When y is the optimal dual of the restricted LP the second term
+is its value (with the artificials' prize included, which only lowers it), so this is the usual
+``z_RMP + N·rc*`` (Farley/Lagrangian) bound. It does not need the LP to be converged or even
+feasible without artificials; duals are clipped to their sign so that the formula holds exactly.
+"""
+
+from __future__ import annotations
+
+import highspy
+import numpy as np
+
+INF = highspy.kHighsInf
+
+
+class Master:
+    def __init__(self, n_nodes: int, prizes: np.ndarray, groups, n_vehicles: int):
+        self.V = n_nodes
+        self.G = len(groups)
+        self.N = n_vehicles
+        self.prizes = np.asarray(prizes, dtype=float)
+        self.groups = [np.asarray(g, dtype=np.int64) + 1 for g in groups]  # solver points
+        self.group_of_point = np.full(n_nodes + 2, -1, dtype=np.int64)
+        for g, pts in enumerate(self.groups):
+            self.group_of_point[pts] = g
+        self.big = 10.0 * (float(self.prizes.sum()) + 1.0)
+        self.n_rows = 1 + self.V + self.G
+        self.row_lo = np.concatenate([[-INF], np.full(self.V, -INF), np.ones(self.G)])
+        self.row_hi = np.concatenate([[float(n_vehicles)], np.ones(self.V), np.full(self.G, INF)])
+        h = highspy.Highs()
+        h.setOptionValue("output_flag", False)
+        h.setOptionValue("threads", 1)
+        h.changeObjectiveSense(highspy.ObjSense.kMaximize)
+        h.addRows(self.n_rows, self.row_lo, self.row_hi, 0, np.zeros(self.n_rows, np.int32),
+                  np.zeros(0, np.int32), np.zeros(0))
+        self.h = h
+        # artificials for node rows 1..V and group rows
+        n_art = self.V + self.G
+        idx = np.arange(1, self.n_rows, dtype=np.int32)
+        h.addCols(n_art, np.full(n_art, -self.big), np.zeros(n_art), np.full(n_art, INF), n_art,
+                  np.arange(n_art, dtype=np.int32), idx, np.ones(n_art))
+        self.n_art = n_art
+        self.routes: list[tuple[int, ...]] = []  # solver points, without start/end
+        self.route_prize: list[float] = []
+        self.seen: set[tuple[int, ...]] = set()
+        cap = 256
+        self._visit = np.zeros((cap, self.V + 2), dtype=bool)
+        self._succ = np.full((cap, self.V + 2), -1, dtype=np.int32)  # successor of each point
+        self._pred = np.full((cap, self.V + 2), -1, dtype=np.int32)
+        self.col_ub = np.zeros(0)
+        self.cur_lo = self.row_lo.copy()
+
+    # -- columns ---------------------------------------------------------------------------
+    @property
+    def n_routes(self) -> int:
+        return len(self.routes)
+
+    def add_routes(self, routes) -> int:
+        """Add new elementary routes (tuples of solver points); return how many were new."""
+        new = [tuple(int(p) for p in r) for r in routes if r and tuple(r) not in self.seen]
+        new = list(dict.fromkeys(new))
+        if not new:
+            return 0
+        k0 = self.n_routes
+        need = k0 + len(new)
+        if need > self._visit.shape[0]:
+            cap = max(need, 2 * self._visit.shape[0])
+            for name, fill in (("_visit", False), ("_succ", -1), ("_pred", -1)):
+                old = getattr(self, name)
+                arr = np.full((cap, self.V + 2), fill, dtype=old.dtype)
+                arr[: old.shape[0]] = old
+                setattr(self, name, arr)
+        starts, idx, vals, costs = [], [], [], []
+        nnz = 0
+        end = self.V + 1
+        for k, r in enumerate(new, start=k0):
+            self.seen.add(r)
+            self.routes.append(r)
+            pts = np.asarray(r, dtype=np.int64)
+            prize = float(self.prizes[pts - 1].sum())
+            self.route_prize.append(prize)
+            self._visit[k, pts] = True
+            full = [0, *r, end]
+            for a, b in zip(full, full[1:]):
+                self._succ[k, a] = b
+                self._pred[k, b] = a
+            coef: dict[int, float] = {0: 1.0}
+            for p in r:
+                coef[p] = 1.0
+                g = self.group_of_point[p]
+                if g >= 0:
+                    row = 1 + self.V + g
+                    coef[row] = coef.get(row, 0.0) + 1.0
+            starts.append(nnz)
+            rows = sorted(coef)
+            idx.extend(rows)
+            vals.extend(coef[i] for i in rows)
+            nnz += len(rows)
+            costs.append(prize)
+        n = len(new)
+        self.h.addCols(n, np.asarray(costs), np.zeros(n), np.full(n, INF), nnz,
+                       np.asarray(starts, np.int32), np.asarray(idx, np.int32), np.asarray(vals))
+        self.col_ub = np.concatenate([self.col_ub, np.full(n, INF)])
+        return n
+
+    # -- branching state -------------------------------------------------------------------
+    def incompatible(self, state) -> np.ndarray:
+        """(n_routes,) bool: routes that a branch-and-bound node's decisions exclude."""
+        k = self.n_routes
+        visit, succ, pred = self._visit[:k], self._succ[:k], self._pred[:k]
+        bad = np.zeros(k, dtype=bool)
+        for p in state.forbidden_nodes:
+            bad |= visit[:, p]
+        for a, b in state.forbidden_arcs:
+            bad |= succ[:, a] == b
+        end = self.V + 1
+        for a, b in state.forced_arcs:
+            if a != 0:
+                bad |= visit[:, a] & (succ[:, a] != b)
+            if b != end:
+                bad |= visit[:, b] & (pred[:, b] != a)
+        return bad
+
+    def apply(self, state) -> None:
+        """Set column and row bounds for a branch-and-bound node."""
+        k = self.n_routes
+        ub = np.where(self.incompatible(state), 0.0, INF)
+        changed = np.flatnonzero(ub != self.col_ub)
+        if changed.size:
+            cols = (changed + self.n_art).astype(np.int32)
+            self.h.changeColsBounds(cols.size, cols, np.zeros(cols.size), ub[changed])
+            self.col_ub = ub
+        lo = self.row_lo.copy()
+        for p in state.forced_nodes:
+            lo[p] = 1.0
+        self.cur_lo = lo
+        self.h.changeRowsBounds(self.V, np.arange(1, self.V + 1, dtype=np.int32), lo[1 : self.V + 1],
+                                self.row_hi[1 : self.V + 1])
+        assert k == self.col_ub.size
+
+    # -- solving ---------------------------------------------------------------------------
+    def solve(self):
+        """Solve the restricted LP. Returns (value, x_routes, x_art, y) with clipped duals."""
+        self.h.run()
+        st = self.h.getModelStatus()
+        if st != highspy.HighsModelStatus.kOptimal:
+            raise RuntimeError(f"master LP status {st}")
+        sol = self.h.getSolution()
+        x = np.asarray(sol.col_value)
+        y = np.asarray(sol.row_dual).copy()
+        lo, hi = self.cur_lo, self.row_hi
+        y[np.isinf(lo) & (y < 0)] = 0.0  # "<=" rows: y >= 0
+        y[np.isinf(hi) & (y > 0)] = 0.0  # ">=" rows: y <= 0
+        value = self.h.getInfo().objective_function_value
+        return value, x[self.n_art :], x[: self.n_art], y
+
+    def point_profit(self, y: np.ndarray) -> np.ndarray:
+        """Reduced prize per solver point (start and end 0): prize - node dual - group dual."""
+        prof = np.zeros(self.V + 2)
+        prof[1 : self.V + 1] = self.prizes - y[1 : self.V + 1]
+        for g, pts in enumerate(self.groups):
+            prof[pts] -= y[1 + self.V + g]
+        return prof
+
+    def lagrangian_bound(self, y: np.ndarray, best_path_prize: float) -> float:
+        """Certified upper bound from duals y and an upper bound on the best path's reduced prize."""
+        lo, hi = self.cur_lo, self.row_hi
+        term = np.where(y > 0, y * np.where(np.isinf(hi), 0.0, hi), y * np.where(np.isinf(lo), 0.0, lo))
+        rc_star = max(0.0, best_path_prize - y[0])
+        return float(term.sum() + self.N * rc_star)
+
+    def node_visits(self, x: np.ndarray) -> np.ndarray:
+        """(V+2,) visit value of each point in an LP solution."""
+        k = self.n_routes
+        return x[:k] @ self._visit[:k]
+
+    def arc_flows(self, x: np.ndarray) -> dict[tuple[int, int], float]:
+        flows: dict[tuple[int, int], float] = {}
+        for r in np.flatnonzero(x > 1e-9):
+            full = [0, *self.routes[r], self.V + 1]
+            for a, b in zip(full, full[1:]):
+                flows[(a, b)] = flows.get((a, b), 0.0) + float(x[r])
+        return flows
+
+    def milp(self, time_limit: float, allowed: np.ndarray | None = None):
+        """Best integer selection of the generated routes (root rows, no branching); routes or None."""
+        k = self.n_routes
+        if k == 0:
+            return None
+        h = highspy.Highs()
+        h.setOptionValue("output_flag", False)
+        h.setOptionValue("threads", 1)
+        h.setOptionValue("time_limit", max(0.05, float(time_limit)))
+        h.setOptionValue("mip_rel_gap", 0.0)
+        h.changeObjectiveSense(highspy.ObjSense.kMaximize)
+        h.addRows(self.n_rows, self.row_lo, self.row_hi, 0, np.zeros(self.n_rows, np.int32),
+                  np.zeros(0, np.int32), np.zeros(0))
+        lp = self.h.getLp()
+        m = lp.a_matrix_
+        starts = np.asarray(m.start_, dtype=np.int64)
+        index = np.asarray(m.index_, dtype=np.int32)
+        value = np.asarray(m.value_)
+        a0 = starts[self.n_art]
+        st = (starts[self.n_art : self.n_art + k] - a0).astype(np.int32)
+        nnz = int(starts[self.n_art + k] - a0)
+        ub = np.ones(k) if allowed is None else np.where(allowed, 1.0, 0.0)
+        h.addCols(k, np.asarray(self.route_prize), np.zeros(k), ub, nnz, st,
+                  index[a0 : a0 + nnz], value[a0 : a0 + nnz])
+        h.changeColsIntegrality(k, np.arange(k, dtype=np.int32),
+                                np.full(k, highspy.HighsVarType.kInteger))
+        h.run()
+        if h.getInfo().primal_solution_status != 2:  # kSolutionStatusFeasible
+            return None
+        x = np.asarray(h.getSolution().col_value)
+        return [self.routes[r] for r in np.flatnonzero(x > 0.5)]

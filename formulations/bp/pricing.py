@@ -1,0 +1,281 @@
+"""Pricing for the route master: a labelling algorithm for the resource-constrained path.
+
+The pricing problem: over paths start -> nodes -> end whose energy (sum of arc costs c_ij =
+e_fly·d_ij + e_image·[j node]) stays within the budget, maximise the sum of node *reduced* prizes
+(the master's duals subtracted). Energy is the only resource; the prize lives on nodes.
+
+One compiled routine (numba) serves three uses, chosen by its arguments:
+
+* **exact elementary** (``ng`` = all nodes for every node): a label is (node, energy, prize,
+  visited set); L1 dominates L2 at the same node if e1 <= e2, p1 >= p2 and visited1 ⊆ visited2.
+* **ng-route relaxation** (``ng[w]`` = a small neighbourhood of w): the remembered set is
+  intersected with ng[w] on arrival at w, so some cycles are allowed. Every elementary path is
+  still an ng-path, so the best ng-path prize is an upper bound on the best elementary one: the
+  master bound stays valid. Only elementary paths ever become columns; when the best ng-paths
+  are not elementary the caller grows the ng sets along their cycles (decremental state space
+  relaxation) and prices again.
+* **heuristic** (``heuristic=True``): dominance ignores the visited sets (paths stay elementary),
+  so there are few labels per node; fast, finds improving columns, proves nothing.
+
+A label is only created if the end is still reachable within the budget (``ret`` = cheapest
+energy to the end in the allowed graph), so every stored label is a complete route candidate:
+its route is its path followed by the end. Sets are bitsets of ``W`` 64-bit words.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from numba import njit, objmode
+
+EPS = 1e-9
+
+
+@njit(cache=True)
+def _grow(arr, size):
+    out = np.empty((size,) + arr.shape[1:], dtype=arr.dtype)
+    out[: arr.shape[0]] = arr
+    return out
+
+
+@njit(cache=True)
+def _completion(mask, room, order, profit, cin):
+    """Fractional-knapsack bound on the prize still collectable with ``room`` energy: each
+    further node w (not remembered in ``mask``) costs at least ``cin[w]``; ``order`` lists the
+    positive-prize nodes by prize/cin, best first."""
+    ub = 0.0
+    for w in order:
+        if mask[w >> 6] & (np.uint64(1) << np.uint64(w & 63)):
+            continue
+        c = cin[w]
+        if c <= 0.0:
+            return np.inf
+        if c <= room:
+            ub += profit[w]
+            room -= c
+        else:
+            return ub + profit[w] * room / c
+    return ub
+
+
+@njit(cache=True)
+def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, threshold,
+           deadline):
+    """Labelling from node 0 to node n-1. Returns (count, node, pred, energy, prize, hit_cap).
+
+    Labels whose prize plus the completion bound cannot exceed ``threshold`` are not stored.
+    """
+    n = cost.shape[0]
+    end = n - 1
+    W = ng.shape[1]
+    cap = 1024
+    node = np.empty(cap, np.int32)
+    pred = np.empty(cap, np.int32)
+    en = np.empty(cap, np.float64)
+    pr = np.empty(cap, np.float64)
+    alive = np.empty(cap, np.bool_)
+    nxt = np.empty(cap, np.int32)
+    mask = np.zeros((cap, W), np.uint64)
+    head = np.full(n, -1, np.int32)
+    node[0] = 0
+    pred[0] = -1
+    en[0] = 0.0
+    pr[0] = 0.0
+    alive[0] = True
+    nxt[0] = -1
+    head[0] = 0
+    count = 1
+    hit = False
+    qi = 0
+    newmask = np.zeros(W, np.uint64)
+    while qi < count:
+        if not alive[qi]:
+            qi += 1
+            continue
+        v = node[qi]
+        for w in range(1, end):
+            if not allowed[w]:
+                continue
+            c = cost[v, w]
+            e2 = en[qi] + c
+            if not (e2 + ret[w] <= budget):  # also rejects inf (forbidden arcs)
+                continue
+            wd = w >> 6
+            wb = np.uint64(1) << np.uint64(w & 63)
+            if mask[qi, wd] & wb:
+                continue
+            p2 = pr[qi] + profit[w]
+            for k in range(W):
+                newmask[k] = mask[qi, k] & ng[w, k]
+            newmask[wd] |= wb
+            if p2 + _completion(newmask, budget - e2, order, profit, cin) <= threshold:
+                continue
+            # dominance against the labels at w
+            dominated = False
+            j = head[w]
+            while j >= 0:
+                if alive[j]:
+                    if en[j] <= e2 + EPS and pr[j] >= p2 - EPS:
+                        sub = True
+                        if not heuristic:
+                            for k in range(W):
+                                if mask[j, k] & ~newmask[k]:
+                                    sub = False
+                                    break
+                        if sub:
+                            dominated = True
+                            break
+                    if e2 <= en[j] + EPS and p2 >= pr[j] - EPS:
+                        sub = True
+                        if not heuristic:
+                            for k in range(W):
+                                if newmask[k] & ~mask[j, k]:
+                                    sub = False
+                                    break
+                        if sub:
+                            alive[j] = False
+                j = nxt[j]
+            if dominated:
+                continue
+            if count == max_labels:
+                hit = True
+                break
+            if (count & 4095) == 0:
+                with objmode(now="float64"):
+                    now = time.perf_counter()
+                if now > deadline:
+                    hit = True
+                    break
+            if count == cap:
+                cap *= 2
+                node = _grow(node, cap)
+                pred = _grow(pred, cap)
+                en = _grow(en, cap)
+                pr = _grow(pr, cap)
+                alive = _grow(alive, cap)
+                nxt = _grow(nxt, cap)
+                mask = _grow(mask, cap)
+            node[count] = w
+            pred[count] = qi
+            en[count] = e2
+            pr[count] = p2
+            alive[count] = True
+            for k in range(W):
+                mask[count, k] = newmask[k]
+            nxt[count] = head[w]
+            head[w] = count
+            count += 1
+        if hit:
+            break
+        qi += 1
+    return count, node[:count], pred[:count], en[:count], pr[:count], hit
+
+
+def n_words(n_points: int) -> int:
+    return (n_points + 63) // 64
+
+
+def full_ng(n_points: int) -> np.ndarray:
+    """ng sets equal to all nodes: exact elementary labelling."""
+    return np.full((n_points, n_words(n_points)), np.uint64(0xFFFFFFFFFFFFFFFF), dtype=np.uint64)
+
+
+def nearest_ng(cost: np.ndarray, size: int) -> np.ndarray:
+    """ng[w] = w and its ``size - 1`` cheapest neighbours (by symmetric arc cost)."""
+    n = cost.shape[0]
+    ng = np.zeros((n, n_words(n)), dtype=np.uint64)
+    sym = np.minimum(cost, cost.T)
+    for w in range(1, n - 1):
+        d = sym[w, 1 : n - 1].copy()
+        d[w - 1] = -1.0
+        for u in np.argsort(d, kind="stable")[:size] + 1:
+            add_to_ng(ng, w, int(u))
+    return ng
+
+
+def add_to_ng(ng: np.ndarray, w: int, u: int) -> None:
+    ng[w, u >> 6] |= np.uint64(1) << np.uint64(u & 63)
+
+
+def cheapest_return(cost: np.ndarray) -> np.ndarray:
+    """Cheapest energy from each point to the end (index n-1) over allowed arcs (Bellman-Ford)."""
+    n = cost.shape[0]
+    ret = cost[:, n - 1].copy()
+    ret[n - 1] = 0.0
+    for _ in range(n):
+        new = np.minimum(ret, (cost[:, 1 : n - 1] + ret[None, 1 : n - 1]).min(axis=1))
+        new[n - 1] = 0.0
+        if np.array_equal(new, ret):
+            break
+        ret = new
+    return ret
+
+
+class PricingResult:
+    """Outcome of one pricing call: the best reduced prize over the searched path set, whether
+    that value is proven (exact search over a relaxation of the elementary routes), and the
+    improving elementary routes found (solver indices, without start and end)."""
+
+    __slots__ = ("best", "exact", "routes", "cycles", "n_labels")
+
+    def __init__(self, best, exact, routes, cycles, n_labels):
+        self.best = best
+        self.exact = exact
+        self.routes = routes
+        self.cycles = cycles
+        self.n_labels = n_labels
+
+
+def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_cols, min_gain,
+          deadline=np.inf):
+    """Run the labelling; return a :class:`PricingResult`.
+
+    ``profit`` holds the reduced prize of every point (0 at start and end); the value reported is
+    the best path prize (the caller subtracts the vehicle dual). ``routes`` are up to ``n_cols``
+    elementary paths with prize > ``min_gain``, best first; ``cycles`` lists, for the best
+    non-elementary ng-paths, their repeated segments (to grow the ng sets).
+    """
+    n = cost.shape[0]
+    end = n - 1
+    pts = np.arange(n)
+    inner = (pts > 0) & (pts < end) & allowed
+    src = inner | (pts == 0)
+    cin = np.where(src[:, None], cost, np.inf)
+    np.fill_diagonal(cin, np.inf)
+    cin = cin.min(axis=0)
+    good = np.flatnonzero(inner & (profit > 0))
+    ratio = np.where(cin[good] > 0, profit[good] / np.maximum(cin[good], 1e-300), np.inf)
+    order = good[np.argsort(-ratio, kind="stable")].astype(np.int64)
+    count, node, pred, en, pr, hit = _label(
+        cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin.astype(np.float64),
+        float(min_gain), float(deadline),
+    )
+    ok = (node > 0) & (en + cost[node, end] <= budget)
+    best = float(pr[ok].max()) if ok.any() else 0.0
+    # Paths pruned by the completion bound are worth at most min_gain; the empty route is 0.
+    best = max(best, 0.0, float(min_gain))
+    cand = np.flatnonzero(ok & (pr > min_gain))
+    cand = cand[np.argsort(-pr[cand], kind="stable")]
+    routes, cycles, seen = [], [], set()
+    for li in cand:
+        path = []
+        j = int(li)
+        while j > 0:
+            path.append(int(node[j]))
+            j = int(pred[j])
+        path.reverse()
+        if len(set(path)) == len(path):
+            key = tuple(path)
+            if key not in seen:
+                seen.add(key)
+                routes.append(key)
+                if len(routes) >= n_cols:
+                    break
+        elif len(cycles) < 20:
+            last = {}
+            for pos, u in enumerate(path):
+                if u in last:
+                    cycles.append(tuple(path[last[u] : pos + 1]))
+                last[u] = pos
+    return PricingResult(best, (not hit) and (not heuristic), routes, cycles, int(count))
