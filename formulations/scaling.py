@@ -43,10 +43,14 @@ class ScaledCosts:
 
 
 def scaled_costs(instance: TOPInstance, resolution: int = DEFAULT_RESOLUTION) -> ScaledCosts:
-    """Scale so that the budget is ``resolution`` integer units (arcs rounded up, budget down)."""
+    """Scale so that the budget is at least ``resolution`` integer units (arcs up, budget down).
+
+    The scale is a power of ten, so decimal data (integer coordinates on a grid, budgets like
+    6 or 7.5) stays exact: a route using exactly the budget is then not lost to rounding.
+    """
     cost = instance.cost_matrix()
     reference = instance.budget if instance.budget > 0 else float(cost.max(initial=0.0))
-    scale = resolution / reference if reference > 0 else 1.0
+    scale = 10.0 ** math.ceil(math.log10(resolution / reference)) if reference > 0 else 1.0
     arc = np.ceil(cost * scale).astype(np.int64)
     np.fill_diagonal(arc, 0)
     arc[0, -1] = 0  # an empty route stays home and costs nothing

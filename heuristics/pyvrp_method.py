@@ -33,6 +33,7 @@ Model (PyVRP's ``Model`` builder):
 from __future__ import annotations
 
 import time
+import warnings
 
 import numpy as np
 from pyvrp import Model
@@ -185,11 +186,14 @@ def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: in
         m.add_edge(end_loc, start_loc, big)
     stop = MultipleCriteria([MaxIterations(ITERATIONS), MaxRuntime(max(time_limit, 0.01))])
     t_solve = time.perf_counter()
-    res = m.solve(stop, seed=seed, collect_stats=False, display=False)
+    with warnings.catch_warnings(record=True) as caught:  # PenaltyBoundWarning on (near-)infeasible data
+        warnings.simplefilter("always")
+        res = m.solve(stop, seed=seed, collect_stats=False, display=False)
     solve_s = time.perf_counter() - t_solve
     best = res.best
     info = {"scale": sc.scale, "iterations": int(res.num_iterations), "covers": with_covers,
-            "stopped_by": "time" if solve_s >= time_limit * 0.98 else "iterations"}
+            "stopped_by": "time" if solve_s >= time_limit * 0.98 else "iterations",
+            "warnings": sorted({type(w.message).__name__ for w in caught})}
     if not best.is_feasible():
         return None, info
     routes: list[list[int]] = [[] for _ in range(n_veh)]

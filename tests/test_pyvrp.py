@@ -1,0 +1,62 @@
+"""`pyvrp` specifics: reproducibility, the group repair, and the integer scaling guarantee."""
+
+import numpy as np
+import pytest
+
+from benchmarks.registry import run_method
+from formulations.generate import generate
+from formulations.instance import TOPInstance, to_top
+from formulations.plan import Plan, Status
+from formulations.scaling import integer_prizes, scaled_costs
+from formulations.verify import route_energy, verify
+from heuristics.pyvrp_method import cover_groups
+
+
+@pytest.mark.parametrize("seed", [0, 7])
+def test_same_seed_same_plan(seed):
+    """Stopped by iterations, PyVRP returns the same plan for the same seed."""
+    inst = to_top(generate(8, 2, 2, seed, e_max=6000.0))
+    a, _ = run_method("pyvrp", inst, seed=seed, time_limit=30.0)
+    b, _ = run_method("pyvrp", inst, seed=seed, time_limit=30.0)
+    assert a.info["stopped_by"] == "iterations"
+    assert a.status == Status.FEASIBLE and a.plan == b.plan
+
+
+def test_cover_groups_repairs_an_uncovering_plan():
+    """A plan missing a group gets the group inserted, evicting the cheapest prize per energy."""
+    inst = TOPInstance(coords=np.array([[0, 4.0], [3, 0.0], [0, -4.0]]), prizes=np.array([5.0, 1.0, 0.0]),
+                       start=np.zeros(2), end=np.zeros(2), budget=9.0, n_vehicles=1, groups=((2,),))
+    repaired = cover_groups(inst, [[0]])
+    assert repaired == [[2]]
+    assert verify(inst, Plan.of(repaired)).valid
+    no_room = TOPInstance(coords=np.array([[0, 4.0], [0, -4.0]]), prizes=np.ones(2), start=np.zeros(2),
+                          end=np.zeros(2), budget=10.0, n_vehicles=1, groups=((0,), (1,)))
+    assert cover_groups(no_room, [[0]]) is None
+
+
+def test_scaled_routes_never_exceed_budget():
+    """Any route within the integer budget is within the true budget (arcs rounded up)."""
+    rng = np.random.default_rng(5)
+    for trial in range(200):
+        v = int(rng.integers(2, 8))
+        inst = TOPInstance(coords=rng.uniform(0, 10, (v, 2)), prizes=np.ones(v), start=rng.uniform(0, 10, 2),
+                           end=rng.uniform(0, 10, 2), budget=float(rng.uniform(5, 40)), n_vehicles=1,
+                           e_image=float(rng.uniform(0, 2)))
+        sc = scaled_costs(inst, resolution=int(rng.choice([10, 1000, 10**6])))
+        route = list(rng.permutation(v)[: int(rng.integers(1, v + 1))])
+        if sc.route_cost([x + 1 for x in route]) <= sc.budget:
+            assert route_energy(inst, route) <= inst.budget * (1 + 1e-12)
+
+
+def test_integer_prizes_dominate():
+    """The smallest positive prize outweighs the given cost bound; zero prizes stay zero."""
+    p = integer_prizes(np.array([0.0, 0.5, 2.0]), dominate=1000)
+    assert p[0] == 0 and p[1] > 1000 and p[2] == 4 * p[1]
+
+
+def test_infeasible_cover_is_no_plan():
+    """Two groups on opposite sides with one vehicle: both passes fail, status NO_PLAN with a reason."""
+    inst = TOPInstance(coords=np.array([[0, 4.0], [0, -4.0]]), prizes=np.ones(2), start=np.zeros(2),
+                       end=np.zeros(2), budget=10.0, n_vehicles=1, groups=((0,), (1,)))
+    res, _ = run_method("pyvrp", inst, time_limit=2.0)
+    assert res.status == Status.NO_PLAN and res.plan is None and res.reason
