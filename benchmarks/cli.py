@@ -161,8 +161,52 @@ def _summary(instance, spec, rec) -> str:
     return "\n".join(lines)
 
 
+# -- bench / report -------------------------------------------------------------------------------
+def _add_bench(sub):
+    p = sub.add_parser("bench", help="run a benchmark suite (built-in name or TOML file) into a results directory")
+    p.add_argument("suite", nargs="?", default="quick", help="built-in suite (quick, exact-small, paper-n, "
+                   "paper-k, top-chao) or a suite TOML file (default quick)")
+    p.add_argument("-o", "--output", help="results directory (default results/<suite>)")
+    p.add_argument("--workers", type=_int_at_least(1), help="parallel worker processes (default: all cores)")
+    p.add_argument("--resume", action="store_true", help="continue a run: skip jobs already stored")
+    p.add_argument("--runs", type=_int_at_least(1), help="random instances per setting (replaces the suite's runs)")
+    p.add_argument("--scheduler", help="run on a Dask cluster, e.g. tcp://HOST:8786")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_bench)
+
+
+def _cmd_bench(args) -> int:
+    from benchmarks.harness import run_suite
+    from benchmarks.suite import load_suite
+
+    suite = load_suite(args.suite, runs=args.runs)
+    out = Path(args.output) if args.output else Path("results") / suite.name
+    summary = run_suite(suite, out, workers=args.workers, resume=args.resume, scheduler=args.scheduler,
+                        progress=not args.quiet)
+    counts = ", ".join(f"{n} {k}" for k, n in sorted(summary["counts"].items())) or "nothing to run"
+    print(f"{summary['suite']}: ran {summary['ran']} of {summary['jobs']} jobs in {summary['wall_s']:.1f} s "
+          f"({counts}) -> {summary['path']}")
+    return 0
+
+
+def _add_report(sub):
+    p = sub.add_parser("report", help="gap report (Markdown, HTML, PNG, CSV) from a results directory")
+    p.add_argument("results", help="results directory written by `sarcover bench`")
+    p.add_argument("-o", "--output", help="report directory (default RESULTS/report)")
+    p.set_defaults(func=_cmd_report)
+
+
+def _cmd_report(args) -> int:
+    from reports.report import write_report
+
+    out = Path(args.output) if args.output else Path(args.results) / "report"
+    summary = write_report(args.results, out)
+    print(summary)
+    return 0
+
+
 # -- main ---------------------------------------------------------------------------------------
-COMMANDS = [_add_generate, _add_solve, _add_methods]
+COMMANDS = [_add_generate, _add_solve, _add_methods, _add_bench, _add_report]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,335 @@
+"""Benchmark suites as data: a TOML file names instance sets × methods × runs, with time limits.
+
+Schema (every key but ``methods`` and ``[[instances]]`` is optional)::
+
+    name = "quick"                     # default: the file name without .toml
+    description = "one line"
+    methods = ["greedy", "milp"]       # registry names (see `sarcover methods`), or "module:function"
+    time_limit = 10.0                  # seconds per job (default 60)
+    seeds = 1                          # method seeds per instance (default 1)
+    grace = 5.0                        # hard kill at time_limit + grace (default 5 s + 20 % of the limit)
+    memory_mb = 4096                   # address-space limit per worker process in MB; 0 = none (default 4096)
+
+    [method.milp]                      # per-method overrides: time_limit, seeds, grace
+    time_limit = 30
+
+    [[instances]]                      # random SAR instances: the grid M × K × N, `runs` instances each
+    M = 20                             # an integer or a list of integers (same for K, N)
+    K = 3
+    N = [2, 3, 4, 5, 6]
+    runs = 1000                        # random instances per (M, K, N) setting: seeds seed, seed+1, ...
+    seed = 0                           # first instance seed (default 0)
+    preset = "paper"                   # generator preset; overrides: altitude, pitch_deg, e_fly, e_image, e_max
+    methods = ["greedy"]               # optional: only these of the suite's methods on this set
+
+    [[instances]]                      # instance files
+    files = ["p2.2.*", "my.json"]      # a bare name or glob is looked up among the TOP benchmark files
+                                       # (benchmarks/instances/top); anything else is a path (glob allowed)
+                                       # relative to the suite file
+
+What a run is. A job is one (instance, method, method seed). On a random SAR set a *run* is a new
+random instance, as in the paper (1000 random instances per setting): the instance seeds are
+``seed .. seed + runs - 1``, and ``sarcover bench --runs R`` replaces every set's ``runs``. On top
+of that each method runs with ``seeds`` method seeds (0 .. seeds-1) per instance, so a setting has
+runs × seeds jobs per method. Files are fixed instances: only ``seeds`` repeats them.
+
+A method named ``"package.module:function"`` (an importable module-level function with the method
+signature) is registered for the run under that name; this is how tests add crashing or hanging
+methods. Everything is checked at load: an unknown method, a bad parameter or a missing file gives
+one :class:`SuiteError` line naming the problem.
+"""
+
+from __future__ import annotations
+
+import csv
+import glob
+import hashlib
+import importlib
+import itertools
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from formulations.errors import SarcoverError
+
+SUITES_DIR = Path(__file__).resolve().parent / "suites"
+TOP_DIR = Path(__file__).resolve().parent / "instances" / "top"
+
+DEFAULT_MEMORY_MB = 4096
+_SUITE_KEYS = {"name", "description", "methods", "time_limit", "seeds", "grace", "memory_mb", "method", "instances"}
+_METHOD_KEYS = {"time_limit", "seeds", "grace"}
+_GEN_KEYS = {"M", "K", "N", "runs", "seed", "preset", "methods", "label"}
+_GEN_OVERRIDES = ("altitude", "pitch_deg", "e_fly", "e_image", "e_max")
+_FILE_KEYS = {"files", "methods", "label"}
+
+
+class SuiteError(SarcoverError):
+    """A suite file that cannot be run; the message names the file and the problem."""
+
+
+@dataclass(frozen=True)
+class Job:
+    """One (instance, method, method seed). ``source`` tells a worker how to build the instance."""
+
+    key: str
+    instance: str
+    method: str
+    seed: int
+    run: int
+    time_limit: float
+    grace: float
+    source: dict = field(hash=False, compare=False)
+
+    def as_dict(self) -> dict:
+        return {
+            "key": self.key, "instance": self.instance, "method": self.method, "seed": self.seed,
+            "run": self.run, "time_limit": self.time_limit, "grace": self.grace, "source": self.source,
+        }
+
+
+@dataclass
+class Suite:
+    name: str
+    path: Path
+    text: str
+    description: str
+    methods: list[str]
+    jobs: list[Job]
+    memory_mb: int
+
+    @property
+    def n_instances(self) -> int:
+        return len({j.instance for j in self.jobs})
+
+
+def builtin_suites() -> list[str]:
+    return sorted(p.stem for p in SUITES_DIR.glob("*.toml"))
+
+
+def resolve_suite_path(name_or_path: str) -> Path:
+    """A built-in suite name (``quick``) or a path to a TOML file."""
+    builtin = SUITES_DIR / f"{name_or_path}.toml"
+    if "/" not in name_or_path and not name_or_path.endswith(".toml") and builtin.exists():
+        return builtin
+    path = Path(name_or_path)
+    if path.is_file():
+        return path
+    known = ", ".join(builtin_suites())
+    raise SuiteError(f"no suite {name_or_path!r}: not a built-in suite ({known}) nor an existing file")
+
+
+def load_suite(name_or_path: str, *, runs: int | None = None) -> Suite:
+    """Read, validate and expand a suite into jobs. ``runs`` replaces every random set's ``runs``."""
+    path = resolve_suite_path(name_or_path)
+    where = path.name
+    try:
+        text = path.read_text()
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SuiteError(f"suite {where}: not valid TOML ({exc})") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SuiteError(f"suite {where}: cannot read ({exc})") from None
+    return _build(data, path, text, runs)
+
+
+def _build(data: dict, path: Path, text: str, runs_override: int | None) -> Suite:
+    where = f"suite {path.name}"
+    _no_unknown(data, _SUITE_KEYS, where)
+    name = data.get("name", path.stem)
+    if not isinstance(name, str) or not name or "/" in name:
+        raise SuiteError(f"{where}: name must be a non-empty string without '/', got {name!r}")
+    methods = data.get("methods")
+    if not isinstance(methods, list) or not methods or not all(isinstance(m, str) for m in methods):
+        raise SuiteError(f"{where}: methods must be a non-empty list of method names")
+    if len(set(methods)) != len(methods):
+        raise SuiteError(f"{where}: methods lists a method twice")
+    exact = {m: check_method(m, where) for m in methods}
+    defaults = {
+        "time_limit": _number(data.get("time_limit", 60.0), f"{where}: time_limit"),
+        "seeds": _integer(data.get("seeds", 1), f"{where}: seeds", 1),
+        "grace": data.get("grace"),
+    }
+    if defaults["grace"] is not None:
+        defaults["grace"] = _number(defaults["grace"], f"{where}: grace", allow_zero=True)
+    memory_mb = _integer(data.get("memory_mb", DEFAULT_MEMORY_MB), f"{where}: memory_mb", 0)
+    per_method = data.get("method", {})
+    if not isinstance(per_method, dict):
+        raise SuiteError(f"{where}: [method.NAME] tables expected")
+    options = {}
+    for m in methods:
+        options[m] = dict(defaults)
+    for m, opts in per_method.items():
+        if m not in methods:
+            raise SuiteError(f"{where}: [method.{m}] names a method not in methods")
+        if not isinstance(opts, dict):
+            raise SuiteError(f"{where}: [method.{m}] must be a table")
+        _no_unknown(opts, _METHOD_KEYS, f"{where}: [method.{m}]")
+        if "time_limit" in opts:
+            options[m]["time_limit"] = _number(opts["time_limit"], f"{where}: [method.{m}] time_limit")
+        if "seeds" in opts:
+            options[m]["seeds"] = _integer(opts["seeds"], f"{where}: [method.{m}] seeds", 1)
+        if "grace" in opts:
+            options[m]["grace"] = _number(opts["grace"], f"{where}: [method.{m}] grace", allow_zero=True)
+    sets = data.get("instances")
+    if not isinstance(sets, list) or not sets or not all(isinstance(s, dict) for s in sets):
+        raise SuiteError(f"{where}: at least one [[instances]] table is needed")
+    jobs: dict[str, Job] = {}
+    sources: dict[str, dict] = {}
+    for i, spec in enumerate(sets, 1):
+        swhere = f"{where}: [[instances]] #{i}"
+        set_methods = spec.get("methods", methods)
+        if not isinstance(set_methods, list) or not set_methods:
+            raise SuiteError(f"{swhere}: methods must be a non-empty list")
+        for m in set_methods:
+            if m not in methods:
+                raise SuiteError(f"{swhere}: method {m!r} is not in the suite's methods")
+        if "files" in spec:
+            _no_unknown(spec, _FILE_KEYS, swhere)
+            instances = _file_sources(spec["files"], path.parent, swhere)
+        else:
+            instances = _generated_sources(spec, swhere, runs_override)
+        for inst_id, source, run in instances:
+            if sources.setdefault(inst_id, source) != source:
+                raise SuiteError(f"{swhere}: instance name {inst_id!r} is used for two different instances")
+            for m in set_methods:
+                opt = options[m]
+                for s in range(opt["seeds"]):
+                    tl = opt["time_limit"]
+                    grace = opt["grace"] if opt["grace"] is not None else 5.0 + 0.2 * tl
+                    key = f"{inst_id}|{m}|{s}"
+                    jobs.setdefault(key, Job(key, inst_id, m, s, run * opt["seeds"] + s, tl, grace,
+                                             {**source, "exact": exact[m]}))
+    return Suite(name, path, text, str(data.get("description", "")), methods, list(jobs.values()), memory_mb)
+
+
+def check_method(name: str, where: str) -> bool:
+    """Raise SuiteError unless ``name`` is a registered method or an importable module:function.
+
+    Returns whether the method is exact.
+    """
+    from benchmarks.registry import METHODS
+
+    if name in METHODS:
+        return METHODS[name].exact
+    if ":" in name:
+        module, _, func = name.partition(":")
+        try:
+            fn = getattr(importlib.import_module(module), func)
+        except (ImportError, AttributeError, ValueError):
+            raise SuiteError(f"{where}: method {name!r}: cannot import function {func!r} from {module!r}") from None
+        if not callable(fn):
+            raise SuiteError(f"{where}: method {name!r} is not callable")
+        return False
+    raise SuiteError(f"{where}: unknown method {name!r}; registered: {', '.join(METHODS)}")
+
+
+def _generated_sources(spec: dict, where: str, runs_override: int | None):
+    from formulations.errors import InstanceError
+    from formulations.generate import PRESETS, generate
+
+    unknown = set(spec) - _GEN_KEYS - set(_GEN_OVERRIDES)
+    if unknown:
+        raise SuiteError(f"{where}: unknown key {sorted(unknown)[0]!r}; a random set takes "
+                         f"{', '.join(sorted(_GEN_KEYS | set(_GEN_OVERRIDES)))}, a file set takes files")
+    for key in ("M", "K", "N"):
+        if key not in spec:
+            raise SuiteError(f"{where}: {key} is missing (or give files = [...])")
+    grid = {key: _int_list(spec[key], f"{where}: {key}") for key in ("M", "K", "N")}
+    runs = runs_override if runs_override is not None else _integer(spec.get("runs", 1), f"{where}: runs", 1)
+    seed0 = _integer(spec.get("seed", 0), f"{where}: seed", 0)
+    preset = spec.get("preset", "paper")
+    if preset not in PRESETS:
+        raise SuiteError(f"{where}: unknown preset {preset!r}; known: {', '.join(PRESETS)}")
+    overrides = {k: _number(spec[k], f"{where}: {k}") for k in _GEN_OVERRIDES if k in spec}
+    suffix = "" if preset == "paper" else f"-{preset}"
+    if overrides:
+        suffix += "-" + "-".join(f"{k}{v:g}" for k, v in sorted(overrides.items()))
+    try:  # one trial draw validates the parameters the generator checks
+        generate(grid["M"][0], grid["K"][0], grid["N"][0], seed0, preset, **overrides)
+    except InstanceError as exc:
+        raise SuiteError(f"{where}: {exc}") from None
+    out = []
+    for m, k, n in itertools.product(grid["M"], grid["K"], grid["N"]):
+        for r in range(runs):
+            seed = seed0 + r
+            inst_id = f"sar-m{m}-k{k}-n{n}-s{seed}{suffix}"
+            source = {"type": "generate", "M": m, "K": k, "N": n, "instance_seed": seed,
+                      "preset": preset, "overrides": overrides}
+            out.append((inst_id, source, r))
+    return out
+
+
+def _file_sources(files, base: Path, where: str):
+    if isinstance(files, str):
+        files = [files]
+    if not isinstance(files, list) or not files or not all(isinstance(f, str) for f in files):
+        raise SuiteError(f"{where}: files must be a non-empty list of file names")
+    out = []
+    for entry in files:
+        if "/" not in entry and not entry.endswith((".txt", ".json")):
+            pattern = str(TOP_DIR / f"{entry}.txt")
+        else:
+            pattern = str(base / entry)
+        matches = sorted(glob.glob(pattern))
+        if not matches:
+            raise SuiteError(f"{where}: instance file {entry!r} not found ({pattern})")
+        for f in matches:
+            p = Path(f).resolve()
+            if not p.is_file():
+                raise SuiteError(f"{where}: {entry!r} is not a file")
+            ref = _published_optimum(p)
+            inst_id = p.stem
+            if p.parent != TOP_DIR:
+                inst_id = f"{p.stem}-{hashlib.sha1(str(p).encode()).hexdigest()[:6]}"
+            out.append((inst_id, {"type": "file", "path": str(p), "reference": ref}, 0))
+    return out
+
+
+_OPTIMA: dict[Path, dict[str, float]] = {}
+
+
+def _published_optimum(path: Path) -> float | None:
+    """The value in optimal.csv next to the file (status optimal only), else None."""
+    table = path.parent / "optimal.csv"
+    if table not in _OPTIMA:
+        values = {}
+        if table.is_file():
+            with table.open() as fh:
+                for row in csv.DictReader(fh):
+                    if row.get("status", "optimal") == "optimal":
+                        try:
+                            values[row["instance"]] = float(row["value"])
+                        except (KeyError, TypeError, ValueError):
+                            continue
+        _OPTIMA[table] = values
+    return _OPTIMA[table].get(path.stem)
+
+
+def _no_unknown(table: dict, allowed: set, where: str) -> None:
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        raise SuiteError(f"{where}: unknown key {unknown[0]!r}; allowed: {', '.join(sorted(allowed))}")
+
+
+def _number(value, where: str, *, allow_zero: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise SuiteError(f"{where} must be a finite number, got {value!r}")
+    if value < 0 or (value == 0 and not allow_zero):
+        raise SuiteError(f"{where} must be {'>= 0' if allow_zero else '> 0'}, got {value!r}")
+    return float(value)
+
+
+def _integer(value, where: str, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise SuiteError(f"{where} must be an integer, got {value!r}")
+    if value < minimum:
+        raise SuiteError(f"{where} must be >= {minimum}, got {value}")
+    return value
+
+
+def _int_list(value, where: str) -> list[int]:
+    values = value if isinstance(value, list) else [value]
+    if not values:
+        raise SuiteError(f"{where} must not be empty")
+    return [_integer(v, where, 1) for v in values]

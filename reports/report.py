@@ -1,0 +1,319 @@
+"""`sarcover report RESULTS_DIR`: Markdown + HTML with PNG plots and CSV tables.
+
+Reads only the results file (and rebuilds one instance through ``formulations`` for the example
+routes plot). Sections: per-method gap table, paper views (coverage against N and against K,
+Fig. 3 and 4; runtime table, Table I; example routes, Fig. 2), gap distributions, time to
+optimality against size for the exact methods, consistency checks, skipped rows.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from reports.gaps import add_gaps, instance_table, method_table  # noqa: E402
+from reports.results import load_results  # noqa: E402
+
+_PCT = ("gap_mean", "gap_median", "gap_max", "share_optimal", "gap_ub_mean", "gap_ub_median",
+        "gap_ub_max", "coverage_mean")
+
+
+class _Doc:
+    """Collects sections once and renders them as Markdown and as HTML."""
+
+    def __init__(self, title: str):
+        self.title, self.parts = title, []
+
+    def h(self, text):
+        self.parts.append(("h", text))
+
+    def p(self, text):
+        self.parts.append(("p", text))
+
+    def table(self, df: pd.DataFrame, csv_name: str | None = None):
+        self.parts.append(("t", (df, csv_name)))
+
+    def img(self, name, alt):
+        self.parts.append(("i", (name, alt)))
+
+    def markdown(self) -> str:
+        out = [f"# {self.title}", ""]
+        for kind, x in self.parts:
+            if kind == "h":
+                out += [f"## {x}", ""]
+            elif kind == "p":
+                out += [x, ""]
+            elif kind == "t":
+                df, csv_name = x
+                out += [_md_table(df), ""]
+                if csv_name:
+                    out += [f"(CSV: [{csv_name}]({csv_name}))", ""]
+            else:
+                out += [f"![{x[1]}]({x[0]})", ""]
+        return "\n".join(out)
+
+    def html(self) -> str:
+        out = ["<!doctype html><html><head><meta charset='utf-8'>", f"<title>{html.escape(self.title)}</title>",
+               "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}table{border-collapse:collapse;"
+               "font-size:13px}td,th{border:1px solid #bbb;padding:2px 6px;text-align:right}"
+               "img{max-width:100%}</style></head><body>", f"<h1>{html.escape(self.title)}</h1>"]
+        for kind, x in self.parts:
+            if kind == "h":
+                out.append(f"<h2>{html.escape(x)}</h2>")
+            elif kind == "p":
+                out.append(f"<p>{html.escape(x)}</p>")
+            elif kind == "t":
+                df, csv_name = x
+                out.append(_fmt(df).to_html(escape=True))
+                if csv_name:
+                    out.append(f"<p>CSV: <a href='{csv_name}'>{csv_name}</a></p>")
+            else:
+                out.append(f"<p><img src='{x[0]}' alt='{html.escape(x[1])}'></p>")
+        out.append("</body></html>")
+        return "\n".join(out)
+
+
+def _fmt(df: pd.DataFrame) -> pd.DataFrame:
+    """Display copy: percentages for gap/coverage/share columns, 3 significant digits elsewhere."""
+    out = df.copy()
+    for col in out.columns:
+        s = out[col]
+        if str(col) in _PCT or str(col).startswith("coverage"):
+            out[col] = [("" if pd.isna(v) else f"{100 * v:.2f}%") for v in s]
+        elif pd.api.types.is_float_dtype(s):
+            out[col] = [("" if pd.isna(v) else f"{v:.3g}") for v in s]
+    return out
+
+
+def _md_table(df: pd.DataFrame) -> str:
+    df = _fmt(df)
+    index_name = df.index.name or ""
+    header = [index_name] + [str(c) for c in df.columns]
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for idx, row in df.iterrows():
+        cells = [str(idx)] + ["" if (not isinstance(v, str) and pd.isna(v)) else str(v) for v in row]
+        lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+    return "\n".join(lines)
+
+
+def _save(fig, out: Path, name: str) -> str:
+    fig.tight_layout()
+    fig.savefig(out / name, dpi=110)
+    plt.close(fig)
+    return name
+
+
+def _coverage_against(sar: pd.DataFrame, x: str, fixed: tuple[str, str], out: Path, fig_no: int, doc: _Doc):
+    """One plot per fixed (a, b) with at least two values of x: mean coverage per method."""
+    tables = []
+    a, b = fixed
+    for (va, vb), g in sar.groupby([a, b]):
+        if g[x].nunique() < 2:
+            continue
+        piv = g.pivot_table(index="method", columns=x, values="coverage", aggfunc="mean")
+        runs = g.groupby(x)["instance"].nunique()
+        fig, ax = plt.subplots(figsize=(6.5, 4.2))
+        for method, vals in piv.iterrows():
+            ax.plot(vals.index, vals.values, marker="o", label=method)
+        ax.set_xlabel(x)
+        ax.set_ylabel("mean coverage")
+        ax.set_xticks(list(piv.columns))
+        ax.set_title(f"Coverage against {x} ({a}={va}, {b}={vb}; {int(runs.min())}–{int(runs.max())} instances per point)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+        name = _save(fig, out, f"coverage_vs_{x}_{a}{va}_{b}{vb}.png")
+        csv = f"coverage_vs_{x}_{a}{va}_{b}{vb}.csv"
+        piv.to_csv(out / csv)
+        piv.columns = [f"{x}={c}" for c in piv.columns]
+        tables.append((va, vb, name, csv, piv))
+    if tables:
+        doc.h(f"Coverage against {x} (paper Fig. {fig_no})")
+        doc.p(f"Mean coverage (covered viewpoints / M·K) over the runs with a plan, {a} and {b} fixed.")
+        for va, vb, name, csv, piv in tables:
+            doc.img(name, f"coverage against {x}, {a}={va}, {b}={vb}")
+            doc.table(piv.rename_axis("method"), csv)
+
+
+def _runtime_table(sar: pd.DataFrame, out: Path, doc: _Doc):
+    g = sar.copy()
+    g["setting"] = [f"M{m} N{n} K{k}" for m, n, k in zip(g["M"], g["N"], g["K"])]
+    order = (g[["M", "N", "K", "setting"]].drop_duplicates().sort_values(["M", "N", "K"])["setting"]).tolist()
+    piv = g.pivot_table(index="method", columns="setting", values="runtime_s", aggfunc="mean")[order]
+    piv.to_csv(out / "runtime_by_setting.csv")
+    doc.h("Runtime per setting (paper Table I)")
+    doc.p("Mean runtime in seconds per run (the method's own clock), per random-instance setting.")
+    doc.table(piv.rename_axis("method"), "runtime_by_setting.csv")
+
+
+def _example_routes(df: pd.DataFrame, out: Path, doc: _Doc):
+    from formulations.generate import generate
+    from formulations.instance import to_top
+    from formulations.io import load_instance
+    from formulations.plan import Plan
+
+    from reports.plots import plot_plan
+
+    ok = df[df["valid"].astype(bool) & df["routes"].notna()]
+    if ok.empty:
+        return
+    counts = ok.groupby("instance")["method"].nunique()
+    sizes = ok.groupby("instance")["n_nodes"].max()
+    sar = ok.groupby("instance")["kind"].first() == "sar"  # the paper's Fig. 2 is a SAR plan
+    pick = sorted(counts.index, key=lambda i: (-counts[i], not sar[i], -sizes[i], i))[0]
+    rows = ok[ok["instance"] == pick].drop_duplicates("method")
+    src = rows.iloc[0]["source"]
+    try:
+        if src["type"] == "generate":
+            instance = to_top(generate(src["M"], src["K"], src["N"], src["instance_seed"], src["preset"],
+                                       **src["overrides"]))
+        else:
+            instance = load_instance(src["path"])
+    except Exception as exc:  # noqa: BLE001 - a moved file must not kill the report
+        doc.h("Example routes (paper Fig. 2)")
+        doc.p(f"Could not rebuild instance {pick}: {exc}")
+        return
+    rows = rows.head(12)
+    cols = min(3, len(rows))
+    nrows = int(np.ceil(len(rows) / cols))
+    fig, axes = plt.subplots(nrows, cols, figsize=(5 * cols, 5 * nrows), squeeze=False)
+    for ax, (_, r) in zip(axes.flat, rows.iterrows()):
+        cov = f"{100 * r['coverage']:.1f}%" if pd.notna(r["coverage"]) else "-"
+        plot_plan(instance, Plan.of(r["routes"]), ax=ax, title=f"{r['method']} ({r['status']}): coverage {cov}")
+    for ax in list(axes.flat)[len(rows):]:
+        ax.axis("off")
+    name = _save(fig, out, "example_routes.png")
+    doc.h("Example routes (paper Fig. 2)")
+    doc.p(f"Instance {pick}: the plan of each method (seed {int(rows.iloc[0]['seed'])}).")
+    doc.img(name, f"routes on {pick}")
+
+
+def _gap_distributions(gapped: pd.DataFrame, out: Path, doc: _Doc):
+    made = []
+    for col, label in (("gap", "gap to proven optimum"), ("gap_ub", "gap to best bound (upper bound on true gap)")):
+        data = {m: 100 * g[col].dropna().to_numpy() for m, g in gapped.groupby("method", sort=False)}
+        data = {m: v for m, v in data.items() if len(v)}
+        if not data:
+            continue
+        fig, ax = plt.subplots(figsize=(max(6, 0.8 * len(data) + 2), 4.2))
+        ax.boxplot(list(data.values()), showmeans=True)
+        ax.set_xticks(range(1, len(data) + 1), list(data.keys()), rotation=30, ha="right")
+        ax.set_ylabel(f"{label} (%)")
+        ax.grid(alpha=0.3, axis="y")
+        made.append((_save(fig, out, f"{col}_distribution.png"), label))
+    if made:
+        doc.h("Gap distributions")
+        for name, label in made:
+            doc.img(name, label)
+
+
+def _time_to_optimality(gapped: pd.DataFrame, out: Path, doc: _Doc):
+    ex = gapped[gapped["exact"].astype(bool)]
+    if ex.empty:
+        return
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    colors = plt.get_cmap("tab10")
+    for i, (m, g) in enumerate(ex.groupby("method")):
+        opt = g[g["status"] == "optimal"]
+        rest = g[g["status"] != "optimal"]
+        ax.scatter(opt["n_nodes"], opt["runtime_s"], color=colors(i % 10), label=f"{m} optimal", s=22)
+        if len(rest):
+            ax.scatter(rest["n_nodes"], rest["runtime_s"], color=colors(i % 10), marker="x", s=28,
+                       label=f"{m} not proven")
+    ax.set_yscale("log")
+    ax.set_xlabel("nodes (viewpoints)")
+    ax.set_ylabel("runtime (s)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    name = _save(fig, out, "time_to_optimality.png")
+    tab = ex.groupby(["method", "n_nodes"]).agg(runs=("status", "size"),
+                                                 optimal=("status", lambda s: int((s == "optimal").sum())),
+                                                 runtime_median_s=("runtime_s", "median"),
+                                                 runtime_max_s=("runtime_s", "max"))
+    tab.to_csv(out / "time_to_optimality.csv")
+    doc.h("Time to optimality against size (exact methods)")
+    doc.p("Dots: proven optimal; crosses: stopped without proof (time limit, error).")
+    doc.img(name, "time to optimality against size")
+    tab = tab.reset_index()
+    tab.index = [f"{m} n={n}" for m, n in zip(tab.pop("method"), tab.pop("n_nodes"))]
+    doc.table(tab.rename_axis("method, size"), "time_to_optimality.csv")
+
+
+def _parquet(df: pd.DataFrame, path: Path) -> bool:
+    flat = df.copy()
+    for col in ("routes", "energy", "covered", "info", "source", "versions"):
+        if col in flat:
+            flat[col] = [None if v is None or (isinstance(v, float) and np.isnan(v)) else json.dumps(v)
+                         for v in flat[col]]
+    try:
+        flat.to_parquet(path, index=False)
+        return True
+    except (ImportError, ValueError, TypeError):
+        return False
+
+
+def write_report(results_dir: str | Path, out_dir: str | Path) -> str:
+    """Write report.md, report.html, PNGs and CSVs into ``out_dir``; return a one-line summary."""
+    df, skipped = load_results(results_dir)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    inst = instance_table(df)
+    gapped = add_gaps(df, inst)
+    methods = method_table(gapped)
+    suites = ", ".join(sorted(str(s) for s in df["suite"].dropna().unique())) or "?"
+    doc = _Doc(f"sarcover report: {suites}")
+    n_opt = int(inst["opt"].notna().sum())
+    doc.p(f"{len(df)} runs: {df['instance'].nunique()} instances × {df['method'].nunique()} methods; "
+          f"{n_opt} instances with a proven optimum, {int((inst['opt'].isna() & inst['best_bound'].notna()).sum())} "
+          f"with a bound only. Source: {Path(results_dir).resolve()}.")
+    bad = {k: v for k, v in skipped.items() if v}
+    if bad:
+        doc.p("Skipped rows: " + ", ".join(f"{v} {k.replace('_', ' ')}" for k, v in bad.items())
+              + " (partial = half-written line of a killed run; old schema = written by another version).")
+    doc.h("Per method")
+    doc.p("gap = (opt − objective) / opt against the proven optimum (gap_* columns, runs with a plan on "
+          "instances with a proven optimum); gap_ub = (bound − objective) / bound against the best bound "
+          "any method proved, on instances without a proven optimum: an upper bound on the true gap. "
+          "share_optimal: share of the runs on proven instances that reached the optimum.")
+    methods.to_csv(out / "methods.csv")
+    doc.table(methods, "methods.csv")
+    inst.to_csv(out / "instances.csv")
+    conflicts = inst[inst["conflict"] != ""]
+    doc.h("Consistency checks")
+    if len(conflicts):
+        doc.p(f"CONFLICTS on {len(conflicts)} instances (a claimed optimum or bound is wrong):")
+        doc.table(conflicts[["opt", "opt_source", "best_bound", "best_objective", "conflict"]])
+    else:
+        doc.p("No conflicts: proven optima agree, no verified objective exceeds a proven optimum or a bound.")
+    errors = gapped[gapped["status"] == "error"]
+    if len(errors):
+        tab = errors.groupby(["method", "reason"]).size().rename("runs").reset_index()
+        tab.index = tab.pop("method")
+        doc.p(f"{len(errors)} runs ended in error:")
+        doc.table(tab.head(30).rename_axis("method"))
+    sar = gapped[(gapped["kind"] == "sar") & gapped["M"].notna()].copy()
+    if len(sar):
+        for c in ("M", "N", "K"):
+            sar[c] = sar[c].astype(int)
+        _coverage_against(sar, "N", ("M", "K"), out, 3, doc)
+        _coverage_against(sar, "K", ("M", "N"), out, 4, doc)
+        _runtime_table(sar, out, doc)
+    _example_routes(df, out, doc)
+    _gap_distributions(gapped, out, doc)
+    _time_to_optimality(gapped, out, doc)
+    gapped.drop(columns=["routes", "info", "source", "versions", "energy", "covered"], errors="ignore").to_csv(
+        out / "runs.csv", index=False)
+    parquet = _parquet(df, out / "results.parquet")
+    (out / "report.md").write_text(doc.markdown())
+    (out / "report.html").write_text(doc.html())
+    n_png = len(list(out.glob("*.png")))
+    note = f", skipped {sum(bad.values())} bad rows" if bad else ""
+    return (f"report: {len(df)} runs, {len(methods)} methods{note} -> {out / 'report.md'}, report.html, "
+            f"{n_png} PNG, CSV tables" + (", results.parquet" if parquet else ""))

@@ -1,0 +1,40 @@
+"""Test-only methods a suite names as "bench_methods:NAME" (module-level, importable by workers)."""
+
+import os
+import time
+
+from formulations.plan import Plan, Result, Status
+
+
+def crash(instance, *, seed=0, time_limit=None):
+    """Raises: the harness must record an error row and go on."""
+    raise RuntimeError("boom")
+
+
+def die(instance, *, seed=0, time_limit=None):
+    """Kills its own process, as a segfault would."""
+    os._exit(3)
+
+
+def hang(instance, *, seed=0, time_limit=None):
+    """Ignores its time limit forever: the harness must kill it."""
+    while True:
+        time.sleep(0.05)
+
+
+def slow_all(instance, *, seed=0, time_limit=None):
+    """Sleeps 0.3 s, then visits every node in one route (for kill/resume tests)."""
+    time.sleep(0.3)
+    return all_optimal(instance)
+
+
+def all_optimal(instance, *, seed=0, time_limit=None):
+    """Every node on vehicle 1, claimed optimal with bound = total prize (tiny easy instances)."""
+    return Result("all", Status.OPTIMAL, Plan.of([list(range(instance.n_nodes))] + [[]] * (instance.n_vehicles - 1)),
+                  bound=float(instance.total_prize))
+
+
+def all_but_last(instance, *, seed=0, time_limit=None):
+    """Every node but the last on vehicle 1 (9 of 10 on a 10-node unit-prize instance)."""
+    return Result("most", Status.FEASIBLE,
+                  Plan.of([list(range(instance.n_nodes - 1))] + [[]] * (instance.n_vehicles - 1)))

@@ -1,0 +1,259 @@
+"""Benchmark harness: suites end to end through the CLI, failures isolated, kill + resume, Dask."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from benchmarks.cli import main
+from benchmarks.harness import run_suite
+from benchmarks.suite import load_suite
+from reports.results import read_rows
+
+TESTS = Path(__file__).resolve().parent
+ROOT = TESTS.parent
+
+
+def write_suite(tmp_path, body: str, name: str = "s.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(body)
+    return path
+
+
+def rows_of(directory) -> list[dict]:
+    rows, skipped = read_rows(directory)
+    assert not any(skipped.values()), skipped
+    return rows
+
+
+SMALL = """
+name = "small"
+methods = ["greedy", "cpsat"]
+time_limit = 10
+[[instances]]
+M = 4
+K = 2
+N = [2, 3]
+runs = 2
+[[instances]]
+files = ["p2.2.b"]
+"""
+
+
+def test_small_suite_end_to_end_cli(tmp_path, capsys):
+    """bench stores one verified row per job with provenance; report writes md, html, png, csv."""
+    suite = write_suite(tmp_path, SMALL)
+    out = tmp_path / "res"
+    assert main(["bench", str(suite), "-o", str(out), "--workers", "2", "--quiet"]) == 0
+    rows = rows_of(out)
+    assert len(rows) == 5 * 2  # (2 settings × 2 runs + 1 file) × 2 methods
+    assert len({r["key"] for r in rows}) == len(rows)
+    for r in rows:
+        assert r["valid"] is True and r["status"] in ("feasible", "optimal")
+        if r["kind"] == "sar":
+            assert r["objective"] == pytest.approx(r["coverage"] * r["M"] * r["K"])
+        assert r["energy_used"] <= r["e_max"] * r["n_vehicles"] * (1 + 1e-9)
+        assert r["versions"]["numpy"] and r["host"] and r["schema"] == 1 and r["workers"] == 2
+    sar = [r for r in rows if r["kind"] == "sar"]
+    assert {(r["N"], r["instance_seed"]) for r in sar} == {(2, 0), (2, 1), (3, 0), (3, 1)}
+    assert pd.read_json(out / "results.jsonl", lines=True).shape[0] == len(rows)  # pandas reads it natively
+    rep = tmp_path / "rep"
+    assert main(["report", str(out), "-o", str(rep)]) == 0
+    for name in ("report.md", "report.html", "methods.csv", "instances.csv", "runs.csv", "example_routes.png",
+                 "coverage_vs_N_M4_K2.png", "runtime_by_setting.csv"):
+        assert (rep / name).stat().st_size > 0, name
+    assert (rep / "example_routes.png").read_bytes()[:4] == b"\x89PNG"
+    assert "Per method" in (rep / "report.md").read_text()
+
+
+def _ten_node_file(tmp_path) -> Path:
+    """Ten unit-prize nodes at x = 1..10 on a line, one vehicle, budget 100: the optimum is 10."""
+    lines = ["n 12", "m 1", "tmax 100", "0 0 0"] + [f"{x} 0 1" for x in range(1, 11)] + ["0 0 0"]
+    path = tmp_path / "line10.txt"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_gap_nine_of_ten_is_ten_percent(tmp_path):
+    """A method at 9 of a proven optimum 10 has gap 10 %; the prover has gap 0 and share optimal 1."""
+    _ten_node_file(tmp_path)
+    suite = write_suite(tmp_path, """
+methods = ["bench_methods:all_optimal", "bench_methods:all_but_last"]
+[[instances]]
+files = ["line10.txt"]
+""")
+    out = tmp_path / "res"
+    assert main(["bench", str(suite), "-o", str(out), "--workers", "1", "--quiet"]) == 0
+    assert main(["report", str(out)]) == 0
+    table = pd.read_csv(out / "report" / "methods.csv", index_col="method")
+    most = table.loc["bench_methods:all_but_last"]
+    assert most["gap_mean"] == pytest.approx(0.10) and most["gap_max"] == pytest.approx(0.10)
+    assert most["share_optimal"] == 0.0
+    best = table.loc["bench_methods:all_optimal"]
+    assert best["gap_mean"] == 0.0 and best["share_optimal"] == 1.0
+    inst = pd.read_csv(out / "report" / "instances.csv", index_col="instance")
+    assert inst["opt"].iloc[0] == 10 and inst["conflict"].isna().all()
+
+
+def test_crashing_dying_and_hanging_methods_do_not_stop_the_suite(tmp_path):
+    """A raise is an error row, a dead worker an error row, a hang is killed as time_limit; greedy runs."""
+    suite = write_suite(tmp_path, """
+methods = ["bench_methods:crash", "bench_methods:die", "bench_methods:hang", "greedy"]
+time_limit = 0.3
+grace = 0.3
+[[instances]]
+M = 3
+K = 2
+N = 2
+runs = 2
+""")
+    out = tmp_path / "res"
+    t0 = time.monotonic()
+    assert main(["bench", str(suite), "-o", str(out), "--workers", "2", "--quiet"]) == 0
+    assert time.monotonic() - t0 < 20
+    by = {}
+    for r in rows_of(out):
+        by.setdefault(r["method"], []).append(r)
+    assert all(len(v) == 2 for v in by.values()) and len(by) == 4
+    assert all(r["status"] == "error" and "boom" in r["reason"] for r in by["bench_methods:crash"])
+    assert all(r["status"] == "error" and "exited with code 3" in r["reason"] for r in by["bench_methods:die"])
+    assert all(r["status"] == "time_limit" and "killed" in r["reason"] for r in by["bench_methods:hang"])
+    assert all(r["status"] == "feasible" and r["valid"] for r in by["greedy"])
+
+
+def test_sigkill_mid_run_then_resume_gives_one_row_per_job(tmp_path):
+    """SIGKILL the bench process mid-way (plus a torn last line); --resume completes, no duplicates."""
+    suite = write_suite(tmp_path, """
+methods = ["bench_methods:slow_all"]
+[[instances]]
+M = 2
+K = 2
+N = 1
+runs = 12
+e_max = 20000  # one UAV can fly all four viewpoints
+""")
+    out = tmp_path / "res"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
+    proc = subprocess.Popen([sys.executable, "-m", "benchmarks.cli", "bench", str(suite), "-o", str(out),
+                             "--workers", "2", "--quiet"], env=env, start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    results = out / "results.jsonl"
+    try:
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline:
+            if results.exists() and results.read_text().count("\n") >= 3:
+                break
+            time.sleep(0.05)
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(10)
+    finally:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)  # the workers die with their parent; be sure
+        except ProcessLookupError:
+            pass
+    before = results.read_text().count("\n")
+    assert 3 <= before < 12, "the kill did not land mid-run"
+    with results.open("a") as fh:  # a row torn in half by the kill
+        fh.write('{"schema": 1, "key": "torn')
+    assert main(["bench", str(suite), "-o", str(out), "--resume", "--quiet"]) == 0
+    rows = rows_of(out)
+    assert len(rows) == 12 and len({r["key"] for r in rows}) == 12
+    assert all(r["status"] == "optimal" for r in rows)
+    assert main(["bench", str(suite), "-o", str(out), "--resume", "--quiet"]) == 0  # nothing left to do
+    assert len(rows_of(out)) == 12
+
+
+def test_dask_path_gives_the_same_results_as_local(tmp_path):
+    """The same suite on a loopback Dask LocalCluster stores the same rows as the local pool."""
+    distributed = pytest.importorskip("dask.distributed")
+    suite = load_suite(str(write_suite(tmp_path, SMALL.replace('"greedy", "cpsat"', '"greedy"'))))
+    run_suite(suite, tmp_path / "local", workers=2, progress=False)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None, host="127.0.0.1", protocol="tcp") as cluster:
+        assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
+        run_suite(suite, tmp_path / "dask", scheduler=cluster.scheduler_address, progress=False)
+
+    def essence(rows):
+        return sorted((r["key"], r["status"], r["objective"], r["routes"], r["valid"]) for r in rows)
+
+    local, dask = rows_of(tmp_path / "local"), rows_of(tmp_path / "dask")
+    assert len(local) == len(suite.jobs) == 5
+    assert essence(local) == essence(dask)
+    assert all(r["workers"] is None for r in dask)
+
+
+def test_existing_results_need_resume(tmp_path, capsys):
+    """Running into a directory that holds results without --resume is a one-line error, exit 2."""
+    suite = write_suite(tmp_path, SMALL.replace('"greedy", "cpsat"', '"greedy"'))
+    out = tmp_path / "res"
+    assert main(["bench", str(suite), "-o", str(out), "--quiet"]) == 0
+    capsys.readouterr()
+    assert main(["bench", str(suite), "-o", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--resume" in err and len(err.splitlines()) == 1
+
+
+@pytest.mark.parametrize("body, needle", [
+    ('methods = ["greedy", "no-such-method"]\n[[instances]]\nM = 3\nK = 2\nN = 1', "unknown method 'no-such-method'"),
+    ('methods = ["greedy"]\n[[instances]]\nM = 3\nK = 0\nN = 1', "K must be >= 1"),
+    ('methods = ["greedy"]\ntime_limit = "long"\n[[instances]]\nM = 3\nK = 2\nN = 1', "time_limit must be a finite number"),
+    ('methods = ["greedy"]\n[[instances]]\nM = 3\nK = 2\nN = 1\nviews = 4', "unknown key 'views'"),
+    ('methods = ["greedy"]\n[[instances]]\nfiles = ["p9.9.z"]', "instance file 'p9.9.z' not found"),
+    ('methods = ["greedy"]\n[[instances]]\nfiles = ["missing.json"]', "instance file 'missing.json' not found"),
+    ('methods = ["greedy"]\n[method.milp]\ntime_limit = 3\n[[instances]]\nM = 3\nK = 2\nN = 1', "[method.milp]"),
+    ('methods = ["greedy"\n', "not valid TOML"),
+])
+def test_bad_suite_files_give_one_line_error(tmp_path, capsys, body, needle):
+    """Unknown method, bad parameter, missing file: one line naming the problem, exit 2, nothing run."""
+    suite = write_suite(tmp_path, body, "bad.toml")
+    assert main(["bench", str(suite), "-o", str(tmp_path / "res"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and needle in err and "bad.toml" in err, err
+    assert not (tmp_path / "res").exists()
+
+
+def test_unknown_suite_name_lists_builtins(capsys):
+    """A suite that is neither built in nor a file is a one-line error listing the built-ins."""
+    assert main(["bench", "no-such-suite", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "quick" in err and "paper-n" in err and len(err.strip().splitlines()) == 1
+
+
+def test_runs_define_instances_and_seeds(tmp_path):
+    """runs = new random instances per setting (--runs overrides); seeds = method seeds per instance."""
+    suite = write_suite(tmp_path, """
+methods = ["greedy"]
+seeds = 2
+[[instances]]
+M = 5
+K = 2
+N = [2, 3]
+runs = 1000
+seed = 10
+""")
+    s = load_suite(str(suite), runs=3)
+    assert len(s.jobs) == 2 * 3 * 2
+    assert {j.source["instance_seed"] for j in s.jobs} == {10, 11, 12}
+    assert {j.seed for j in s.jobs} == {0, 1}
+    assert sorted(j.run for j in s.jobs if j.source["N"] == 2) == list(range(6))
+    assert len(load_suite(str(suite)).jobs) == 2 * 1000 * 2
+
+
+def test_builtin_suites_load_with_registered_methods():
+    """Every built-in suite parses, names only registered methods, and paper-n is M=20, K=3, N=2..6."""
+    from benchmarks.suite import builtin_suites
+
+    assert {"quick", "exact-small", "paper-n", "paper-k", "top-chao"} <= set(builtin_suites())
+    for name in builtin_suites():
+        suite = load_suite(name, runs=2)
+        assert suite.jobs, name
+    paper_n = load_suite("paper-n", runs=2)
+    assert {(j.source["M"], j.source["K"], j.source["N"]) for j in paper_n.jobs} == {(20, 3, n) for n in range(2, 7)}
+    assert not any(j.source["exact"] for j in paper_n.jobs)
+    assert load_suite("top-chao").n_instances == 117
