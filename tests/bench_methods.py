@@ -38,3 +38,9 @@ def all_but_last(instance, *, seed=0, time_limit=None):
     """Every node but the last on vehicle 1 (9 of 10 on a 10-node unit-prize instance)."""
     return Result("most", Status.FEASIBLE,
                   Plan.of([list(range(instance.n_nodes - 1))] + [[]] * (instance.n_vehicles - 1)))
+
+
+def hog(instance, *, seed=0, time_limit=None):
+    """Allocates 3 GB at once: under the suite's memory_mb limit this is a MemoryError."""
+    block = bytearray(3 * 1024**3)
+    return Result("hog", Status.NO_PLAN, reason=str(len(block)))

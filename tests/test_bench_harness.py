@@ -101,12 +101,13 @@ files = ["line10.txt"]
     assert inst["opt"].iloc[0] == 10 and inst["conflict"].isna().all()
 
 
-def test_crashing_dying_and_hanging_methods_do_not_stop_the_suite(tmp_path):
-    """A raise is an error row, a dead worker an error row, a hang is killed as time_limit; greedy runs."""
+def test_crashing_dying_hanging_and_hogging_methods_do_not_stop_the_suite(tmp_path):
+    """Raise / dead worker / memory hog: error rows; a hang is killed as time_limit; greedy still runs."""
     suite = write_suite(tmp_path, """
-methods = ["bench_methods:crash", "bench_methods:die", "bench_methods:hang", "greedy"]
+methods = ["bench_methods:crash", "bench_methods:die", "bench_methods:hang", "bench_methods:hog", "greedy"]
 time_limit = 0.3
 grace = 0.3
+memory_mb = 1500
 [[instances]]
 M = 3
 K = 2
@@ -120,10 +121,11 @@ runs = 2
     by = {}
     for r in rows_of(out):
         by.setdefault(r["method"], []).append(r)
-    assert all(len(v) == 2 for v in by.values()) and len(by) == 4
+    assert all(len(v) == 2 for v in by.values()) and len(by) == 5
     assert all(r["status"] == "error" and "boom" in r["reason"] for r in by["bench_methods:crash"])
     assert all(r["status"] == "error" and "exited with code 3" in r["reason"] for r in by["bench_methods:die"])
     assert all(r["status"] == "time_limit" and "killed" in r["reason"] for r in by["bench_methods:hang"])
+    assert all(r["status"] == "error" and "MemoryError" in r["reason"] for r in by["bench_methods:hog"])
     assert all(r["status"] == "feasible" and r["valid"] for r in by["greedy"])
 
 
