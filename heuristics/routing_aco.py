@@ -11,8 +11,8 @@ which then deposits as the elitist ant (without it the ant system found the opti
 10-point convex polygon in 27 of 30 runs, for any β ∈ {2, 3, 5}, ρ ∈ {0.1, 0.3, 0.5}).
 
 Vectorised over ants and clusters at once: the colony is (B, P) ants, a step draws every ant's
-next viewpoint with the Gumbel-max trick (argmax of log-weight + Gumbel noise, which samples the
-same distribution as a roulette wheel) and deposits use one ``np.bincount``. The only Python loop
+next viewpoint by a roulette wheel (a cumulative sum over the candidates and one uniform draw per
+ant), and deposits use one ``np.bincount``. The only Python loop
 is over the L construction steps.
 """
 
@@ -24,7 +24,12 @@ import numpy as np
 
 from heuristics.tour import ClusterBatch, best_two_opt_moves, invert
 
-_PAD = -1e300  # log-weight of a pad: chosen only once every real viewpoint is visited
+_PAD = -1e300
+# Weight of a pad: absorbed in the wheel's total (≥ 1e-20 while real viewpoints remain, since
+# the weights are normalised per row and floored), so a pad is drawn only once a row's viewpoints are done.
+# Real weights are floored at 1e-20 (float32 keeps them apart from pads) before normalisation.
+_PAD_WEIGHT = 1e-38
+_MIN_WEIGHT = 1e-20
 
 
 class ACORouter:
@@ -59,7 +64,9 @@ class ACORouter:
         log_eta = -self.beta * np.log(np.maximum(dist, 1e-9))
         log_eta = np.where(pad[:, None, :], _PAD, log_eta)
         tau = np.ones((B, L + 1, L))
-        b_idx = np.arange(B)[:, None]
+        row_state = (np.arange(B) * (L + 1))[:, None]  # row of (b, state) in weight
+        ant_base = (np.arange(B * P) * L).reshape(B, P)
+        pad3 = np.broadcast_to(pad[:, None, :], (B, L + 1, L))
         flat_base = (np.arange(B) * (L + 1) * L)[:, None, None]
         best_f = np.full(B, np.inf)
         best = np.tile(np.arange(L), (B, 1))
@@ -67,16 +74,24 @@ class ACORouter:
         for it in range(self.n_iterations):
             if deadline is not None and time.perf_counter() > deadline:
                 break
-            logw = self.alpha * np.log(tau) + log_eta  # (B, L+1, L)
-            noise = rng.gumbel(size=(L, B, P, L))
-            visited = np.zeros((B, P, L))  # 0 or -inf, added to the log-weights
-            cur = np.full((B, P), L)
-            tours = np.empty((B, P, L), dtype=int)
-            for s in range(L):
-                nxt = np.argmax(logw[b_idx, cur] + visited + noise[s], axis=-1)
-                tours[:, :, s] = nxt
-                np.put_along_axis(visited, nxt[..., None], -np.inf, axis=-1)
-                cur = nxt
+            logw = self.alpha * np.log(tau) + log_eta  # (B, L+1, L), pads -1e300
+            weight = np.maximum(np.exp(logw - logw.max(axis=-1, keepdims=True)), _MIN_WEIGHT)
+            weight[pad3] = _PAD_WEIGHT
+            weight = weight.astype(np.float32).reshape(B * (L + 1), L)
+            avail = np.ones(B * P * L, dtype=np.float32)
+            cur = np.full((B, P), L) + row_state
+            tours = np.empty((L, B, P), dtype=int)
+            u = rng.random((L, B, P), dtype=np.float32) * np.float32(1.0 - 1e-6)  # r < total
+            for s in range(L - 1):
+                w = np.take(weight, cur, axis=0)
+                w *= avail.reshape(B, P, L)
+                np.cumsum(w, axis=-1, out=w)  # roulette wheel over the unvisited
+                nxt = np.argmax(w > (u[s] * w[..., -1])[..., None], axis=-1)
+                tours[s] = nxt
+                avail[ant_base + nxt] = 0.0
+                cur = row_state + nxt
+            tours[L - 1] = np.argmax(avail.reshape(B, P, L), axis=-1)  # the one left
+            tours = tours.transpose(1, 2, 0)
             f = batch.lengths(D, tours)
             k = np.argmin(f, axis=1)
             fk = f[np.arange(B), k]

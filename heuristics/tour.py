@@ -79,7 +79,10 @@ class ClusterBatch:
         out = [np.asarray(c, dtype=int) for c in clusters]
         for row, i in enumerate(self.which):
             n = self.sizes[row]
-            out[i] = self.nodes[row, best_local[row, :n]]
+            order = best_local[row, :n]
+            if not np.array_equal(np.sort(order), np.arange(n)):  # a router bug, never silent
+                raise RuntimeError(f"router returned an invalid order for cluster {i}")
+            out[i] = self.nodes[row, order]
         return out
 
 
