@@ -72,7 +72,7 @@ class _Stats:
 
 
 class BranchAndPrice:
-    def __init__(self, instance: TOPInstance, *, time_limit: float | None, ng_size: int = 12,
+    def __init__(self, instance: TOPInstance, *, time_limit: float | None, ng_size: int = 8,
                  initial_routes=None):
         self.inst = instance
         self.t0 = time.perf_counter()
@@ -291,7 +291,7 @@ class BranchAndPrice:
 
 
 def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
-             initial_routes=None, ng_size: int = 12) -> Result:
+             initial_routes=None, ng_size: int = 8) -> Result:
     """Branch-and-price: proven optimum, or the best plan and a certified bound at the limit.
 
     ``initial_routes`` (node ids, e.g. a heuristic plan's routes) are added as starting columns

@@ -160,6 +160,8 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             pred[count] = qi
             en[count] = e2
             pr[count] = p2
+            if not heuristic and p2 > threshold and e2 + cost[w, end] <= budget:
+                threshold = p2  # exact mode looks for the best path: prune against the best found
             alive[count] = True
             for k in range(W):
                 mask[count, k] = newmask[k]
