@@ -1,0 +1,31 @@
+"""The registered `cpsat` method: CP-SAT warm-started with greedy's plan.
+
+:mod:`formulations.cpsat` cannot import heuristics (imports flow one way), so this wrapper runs
+:func:`heuristics.greedy.greedy` (milliseconds) and hands its plan to
+:func:`formulations.cpsat.solve_cpsat` as a CP-SAT hint. Measured: with one worker CP-SAT alone
+found no plan within 60 s on 6 of the 30-node TOP instances of set 1, and found one quickly with
+the hint. The hint changes neither the model nor the proof; only the search starts there.
+"""
+
+from __future__ import annotations
+
+import time
+
+from formulations.cpsat import solve_cpsat
+from formulations.instance import TOPInstance
+from formulations.plan import Result, Status
+from heuristics.greedy import greedy
+
+THREADS = 1  # one CP-SAT worker: fair next to single-threaded heuristics and reproducible enough
+
+
+def cpsat(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0) -> Result:
+    """`cpsat` with one worker and greedy's plan (if it has one) as the hint."""
+    t0 = time.perf_counter()
+    warm = greedy(instance)
+    hint = warm.plan if warm.status == Status.FEASIBLE else None
+    remaining = None if time_limit is None else max(time_limit - (time.perf_counter() - t0), 0.01)
+    res = solve_cpsat(instance, seed=seed, time_limit=remaining, threads=THREADS, hint=hint)
+    res.info["hint"] = "greedy" if hint is not None else None
+    res.runtime_s = time.perf_counter() - t0
+    return res
