@@ -279,6 +279,12 @@ def _worker_main(conn, memory_mb: int, parent_pid: int) -> None:
     if os.getppid() != parent_pid:
         os._exit(0)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's business
+    try:  # solver chatter on stdout would tear the progress bar; stderr stays for crashes
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 1)
+        os.close(devnull)
+    except OSError:
+        pass
     if memory_mb:
         import resource
 

@@ -132,8 +132,9 @@ def _coverage_against(sar: pd.DataFrame, x: str, fixed: tuple[str, str], out: Pa
         name = _save(fig, out, f"coverage_vs_{x}_{a}{va}_{b}{vb}.png")
         csv = f"coverage_vs_{x}_{a}{va}_{b}{vb}.csv"
         piv.to_csv(out / csv)
-        piv.columns = [f"{x}={c}" for c in piv.columns]
-        tables.append((va, vb, name, csv, piv))
+        shown = piv.map(lambda v: "" if pd.isna(v) else f"{100 * v:.1f}%")
+        shown.columns = [f"{x}={c}" for c in piv.columns]
+        tables.append((va, vb, name, csv, shown))
     if tables:
         doc.h(f"Coverage against {x} (paper Fig. {fig_no})")
         doc.p(f"Mean coverage (covered viewpoints / M·K) over the runs with a plan, {a} and {b} fixed.")
@@ -189,6 +190,7 @@ def _example_routes(df: pd.DataFrame, out: Path, doc: _Doc):
         plot_plan(instance, Plan.of(r["routes"]), ax=ax, title=f"{r['method']} ({r['status']}): coverage {cov}")
     for ax in list(axes.flat)[len(rows):]:
         ax.axis("off")
+    fig.suptitle(f"Example routes on {pick}", fontsize=13)
     name = _save(fig, out, "example_routes.png")
     doc.h("Example routes (paper Fig. 2)")
     doc.p(f"Instance {pick}: the plan of each method (seed {int(rows.iloc[0]['seed'])}).")
@@ -205,7 +207,8 @@ def _gap_distributions(gapped: pd.DataFrame, out: Path, doc: _Doc):
         fig, ax = plt.subplots(figsize=(max(6, 0.8 * len(data) + 2), 4.2))
         ax.boxplot(list(data.values()), showmeans=True)
         ax.set_xticks(range(1, len(data) + 1), list(data.keys()), rotation=30, ha="right")
-        ax.set_ylabel(f"{label} (%)")
+        ax.set_ylabel(f"{label} (%)" if col == "gap" else "gap to best bound (%)")
+        ax.set_title(f"{label.capitalize()}, per method (triangle: mean)")
         ax.grid(alpha=0.3, axis="y")
         made.append((_save(fig, out, f"{col}_distribution.png"), label))
     if made:
@@ -267,6 +270,7 @@ def write_report(results_dir: str | Path, out_dir: str | Path) -> str:
     inst = instance_table(df)
     gapped = add_gaps(df, inst)
     methods = method_table(gapped)
+    methods = methods.loc[sorted(methods.index, key=lambda m: (not methods.loc[m, "exact"], m))]
     suites = ", ".join(sorted(str(s) for s in df["suite"].dropna().unique())) or "?"
     doc = _Doc(f"sarcover report: {suites}")
     n_opt = int(inst["opt"].notna().sum())

@@ -179,7 +179,8 @@ def test_dask_path_gives_the_same_results_as_local(tmp_path):
     with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
                                   dashboard_address=None, host="127.0.0.1", protocol="tcp") as cluster:
         assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
-        run_suite(suite, tmp_path / "dask", scheduler=cluster.scheduler_address, progress=False)
+        assert main(["bench", str(suite.path), "-o", str(tmp_path / "dask"), "--quiet",
+                     "--scheduler", cluster.scheduler_address]) == 0
 
     def essence(rows):
         return sorted((r["key"], r["status"], r["objective"], r["routes"], r["valid"]) for r in rows)
@@ -259,3 +260,17 @@ def test_builtin_suites_load_with_registered_methods():
     assert {(j.source["M"], j.source["K"], j.source["N"]) for j in paper_n.jobs} == {(20, 3, n) for n in range(2, 7)}
     assert not any(j.source["exact"] for j in paper_n.jobs)
     assert load_suite("top-chao").n_instances == 117
+
+
+def test_progress_bar_counts_and_eta():
+    """The progress bar prints count, percentage and an ETA; errors and time limits are tallied."""
+    import io
+
+    from benchmarks.harness import Progress
+
+    stream = io.StringIO()
+    bar = Progress(4, "bench t", stream=stream)
+    for status in ("feasible", "error", "time_limit", "optimal"):
+        bar.update(status)
+    last = stream.getvalue().strip().splitlines()[-1]
+    assert "4/4" in last and "100%" in last and "ETA 0:00" in last and "1 error" in last and "1 time_limit" in last
