@@ -44,3 +44,9 @@ def hog(instance, *, seed=0, time_limit=None):
     """Allocates 3 GB at once: under the suite's memory_mb limit this is a MemoryError."""
     block = bytearray(3 * 1024**3)
     return Result("hog", Status.NO_PLAN, reason=str(len(block)))
+
+
+def nap(instance, *, seed=0, time_limit=None):
+    """Sleeps 2 s whatever its time limit (a finite hang, for the Dask soft deadline)."""
+    time.sleep(2.0)
+    return all_optimal(instance)

@@ -172,7 +172,7 @@ e_max = 20000  # one UAV can fly all four viewpoints
 
 
 def test_dask_path_gives_the_same_results_as_local(tmp_path):
-    """The same suite on a loopback Dask LocalCluster stores the same rows as the local pool."""
+    """Dask on loopback stores the same rows as the local pool; a job past its deadline is time_limit."""
     distributed = pytest.importorskip("dask.distributed")
     suite = load_suite(str(write_suite(tmp_path, SMALL.replace('"greedy", "cpsat"', '"greedy"'))))
     run_suite(suite, tmp_path / "local", workers=2, progress=False)
@@ -181,6 +181,12 @@ def test_dask_path_gives_the_same_results_as_local(tmp_path):
         assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
         assert main(["bench", str(suite.path), "-o", str(tmp_path / "dask"), "--quiet",
                      "--scheduler", cluster.scheduler_address]) == 0
+        napping = write_suite(tmp_path, 'methods = ["bench_methods:nap"]\ntime_limit = 0.2\ngrace = 0.2\n'
+                                        '[[instances]]\nM = 2\nK = 2\nN = 1', "nap.toml")
+        assert main(["bench", str(napping), "-o", str(tmp_path / "nap"), "--quiet",
+                     "--scheduler", cluster.scheduler_address]) == 0
+    [nap] = rows_of(tmp_path / "nap")
+    assert nap["status"] == "time_limit" and "abandoned" in nap["reason"]
 
     def essence(rows):
         return sorted((r["key"], r["status"], r["objective"], r["routes"], r["valid"]) for r in rows)
