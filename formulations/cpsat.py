@@ -378,9 +378,10 @@ def solve_cpsat(
     if st == cp_model.MODEL_INVALID:
         return done(Status.ERROR, reason="CP-SAT: model invalid " + built.m.validate())
     if st not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
-        nb = solver.best_objective_bound
-        nb = math.floor(nb + 1e-6) / pscale if math.isfinite(nb) else None
-        return done(Status.TIME_LIMIT, bound=nb, reason=f"CP-SAT found no plan ({solver.status_name(st)})")
+        # No incumbent: CP-SAT's best_objective_bound is not reliable then (it reads 0), so no bound.
+        if hint is not None and verify(instance, hint).valid:
+            return done(Status.TIME_LIMIT, hint, None, reason="time limit; CP-SAT found no plan, the hint is returned")
+        return done(Status.TIME_LIMIT, reason=f"CP-SAT found no plan ({solver.status_name(st)})")
     ibound = int(round(solver.best_objective_bound)) if st == cp_model.FEASIBLE else int(round(solver.objective_value))
     ibound = max(ibound, int(round(solver.objective_value)))
     bound = ibound / pscale
