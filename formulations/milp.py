@@ -1,0 +1,473 @@
+"""`milp`: the team orienteering problem as a compact MILP on HiGHS, through Pyomo.
+
+The model (:func:`build_milp`) is the two-index single-commodity "time-flow" formulation of the
+TOP literature (Bianchessi, Mansini & Speranza 2018), aggregated over vehicles, so it has no
+vehicle symmetry at all:
+
+- ``x[i, j]`` binary: some vehicle travels arc (i, j); only arcs that a route within the budget
+  can use exist (:func:`formulations.preprocess.prune_arcs`).
+- ``y[i]`` binary: node i is visited; ``sum(x[start, j]) <= N`` vehicles leave the start.
+- ``z[i, j] >= 0``: the energy a vehicle has used when it arrives at j over (i, j). Flow
+  conservation at a node adds the cost of the arc leaving it; the lifted bounds
+  ``(c_0i + c_ij) x_ij <= z_ij <= (B - c_j,end) x_ij`` are the per-route budget (the paper's
+  constraint (3)) with the tightest big-M the triangle inequality gives.
+- each node at most once (4): in-degree = out-degree = ``y[i]``; each group at least one
+  visited node (5); maximise the prize.
+
+Flow strictly increases along an arc of positive cost, so subtours can appear only among
+coincident free points; they, and violated connectivity cuts of the LP relaxation, are added in
+a loop (HiGHS has no cut callback): :func:`solve_milp` first runs a few rounds of LP
+relaxation + connectivity-cut separation (max-flow), then solves the MIP, checks the plan for
+subtours and with the independent verifier, and re-solves with a cut if needed.
+
+Exactness: HiGHS runs with ``mip_rel_gap = 0`` and, for integer prizes, an absolute gap below
+the prize lattice step; the model budget is the verifier's own acceptance threshold, so no plan
+the verifier accepts is cut off (the bound is valid). A plan HiGHS returns that the verifier
+rejects (possible only within HiGHS's feasibility tolerance) is never reported: its route is cut
+off by a no-good cut, which removes only that infeasible route, and the model is re-solved.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pyomo.environ as pyo
+from pyomo.contrib.solver.common.factory import SolverFactory
+from pyomo.contrib.solver.common.results import TerminationCondition
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import maximum_flow
+
+from formulations.instance import TOPInstance, precheck
+from formulations.plan import Plan, Result, Status
+from formulations.preprocess import (
+    ArcGraph,
+    floor_to_lattice,
+    incompatibility,
+    incompatible_cliques,
+    prize_lattice,
+    prune_arcs,
+)
+from formulations.verify import verify
+
+METHOD = "milp"
+_CUT_TOL = 1e-4  # a connectivity cut is added when violated by more than this
+
+
+def build_milp(
+    instance: TOPInstance, graph: ArcGraph | None = None, *, two_cycle: bool = True, cliques: bool = True,
+    paths: bool = True,
+) -> pyo.ConcreteModel:
+    """The time-flow TOP model of ``instance`` (see the module docstring). Pure: solves nothing.
+
+    ``graph`` is the pruned arc set (computed if omitted). ``two_cycle`` adds
+    x_ij + x_ji <= y_i for node pairs, which removes 2-node subtours and tightens the LP.
+    ``cliques`` adds sum_{i in K} y_i <= (vehicles used) for sets K of pairwise incompatible
+    nodes (:func:`formulations.preprocess.incompatible_cliques`): a route visits at most one.
+    Components: sets ``N`` (node solver indices), ``A`` (arcs); variables ``x``, ``y``, ``z``;
+    ``cuts`` is an empty ConstraintList for the cuts added while solving.
+    """
+    g = prune_arcs(instance) if graph is None else graph
+    cost, budget, s, e = g.cost, g.budget, g.start, g.end
+    m = pyo.ConcreteModel(name=f"top_timeflow[{instance.name}]")
+    m.N = pyo.Set(initialize=list(g.nodes), ordered=True, doc="reachable nodes (solver index = node id + 1)")
+    m.A = pyo.Set(initialize=list(g.arcs), dimen=2, ordered=True, doc="arcs some within-budget route can use")
+    out_arcs: dict[int, list] = {i: [] for i in (s, *g.nodes)}
+    in_arcs: dict[int, list] = {j: [] for j in (*g.nodes, e)}
+    for i, j in g.arcs:
+        out_arcs[i].append((i, j))
+        in_arcs[j].append((i, j))
+
+    m.x = pyo.Var(m.A, domain=pyo.Binary, doc="1 if a vehicle travels the arc")
+    m.y = pyo.Var(m.N, domain=pyo.Binary, doc="1 if the node is visited")
+    m.z = pyo.Var(m.A, domain=pyo.NonNegativeReals, doc="energy used on arrival at the arc's head")
+
+    m.prize = pyo.Objective(
+        expr=sum(float(instance.prizes[i - 1]) * m.y[i] for i in m.N), sense=pyo.maximize,
+        doc="total prize of the visited nodes",
+    )
+
+    @m.Constraint(m.N, doc="(4) a visited node is left exactly once")
+    def leave(m, i):
+        return sum(m.x[a] for a in out_arcs[i]) == m.y[i]
+
+    @m.Constraint(m.N, doc="(4) a visited node is entered exactly once")
+    def enter(m, j):
+        return sum(m.x[a] for a in in_arcs[j]) == m.y[j]
+
+    m.fleet = pyo.Constraint(expr=sum(m.x[a] for a in out_arcs[s]) <= instance.n_vehicles,
+                             doc="at most N vehicles leave the start")
+
+    @m.Constraint(range(len(instance.groups)), doc="(5) every group has a visited node")
+    def cover(m, gi):
+        nodes = [v + 1 for v in instance.groups[gi] if v + 1 in m.N]
+        if not nodes:
+            return pyo.Constraint.Infeasible
+        return sum(m.y[i] for i in nodes) >= 1
+
+    @m.Constraint(m.N, doc="time flow: out-flow = in-flow + cost of the arc taken out")
+    def flow(m, i):
+        return (sum(m.z[a] for a in out_arcs[i]) - sum(m.z[a] for a in in_arcs[i])
+                == sum(float(cost[a]) * m.x[a] for a in out_arcs[i]))
+
+    @m.Constraint(out_arcs[s], doc="time flow leaving the start is the first arc's cost")
+    def flow_start(m, i, j):
+        return m.z[i, j] == float(cost[i, j]) * m.x[i, j]
+
+    @m.Constraint(m.A, doc="(3) lifted budget: z_ij <= (B - c_j,end) x_ij")
+    def budget_ub(m, i, j):
+        cap = budget if j == e else budget - float(g.to_end[j])
+        return m.z[i, j] <= max(cap, 0.0) * m.x[i, j]
+
+    @m.Constraint([a for a in g.arcs if a[0] != s], doc="lifted lower bound: z_ij >= (c_0i + c_ij) x_ij")
+    def budget_lb(m, i, j):
+        return m.z[i, j] >= float(g.from_start[i] + cost[i, j]) * m.x[i, j]
+
+    pairs = [(i, j) for (i, j) in g.arcs if i != s and j != e and i < j and (j, i) in m.A] if two_cycle else []
+
+    @m.Constraint(pairs, doc="no 2-node subtour: x_ij + x_ji <= y_i, y_j")
+    def two_cycle_i(m, i, j):
+        return m.x[i, j] + m.x[j, i] <= m.y[i]
+
+    @m.Constraint(pairs, doc="no 2-node subtour: x_ij + x_ji <= y_j")
+    def two_cycle_j(m, i, j):
+        return m.x[i, j] + m.x[j, i] <= m.y[j]
+
+    cl = incompatible_cliques(g, instance.n_vehicles) if cliques else []
+    m._clique_sets = list(cl)  # for the solve loop: cliques already in the model
+
+    @m.Constraint(range(len(cl)), doc="a route visits at most one node of a pairwise-incompatible set")
+    def clique(m, k):
+        return sum(m.y[i] for i in cl[k]) <= sum(m.x[a] for a in out_arcs[s])
+
+    # Infeasible 2-arc paths i -> k -> j (c_0i + c_ik + c_kj + c_j,end > B): after entering k
+    # from i a vehicle cannot leave to any such j, so x_ik + sum_j x_kj <= y_k.
+    limit = budget * (1.0 + 1e-9)
+    path_rows = []
+    if paths:
+        for i, k in g.arcs:
+            if i == s or k == e:
+                continue
+            base = float(g.from_start[i] + cost[i, k])
+            bad = [(k2, j) for (k2, j) in out_arcs[k] if j != i and j != e and base + cost[k, j] + g.to_end[j] > limit]
+            if bad:
+                path_rows.append(((i, k), bad))
+
+    @m.Constraint(range(len(path_rows)), doc="no infeasible 2-arc path i -> k -> j")
+    def path(m, r):
+        (i, k), bad = path_rows[r]
+        return m.x[i, k] + sum(m.x[a] for a in bad) <= m.y[k]
+
+    m.cuts = pyo.ConstraintList(doc="connectivity and no-good cuts added while solving")
+    m._graph = g  # kept for the solve loop (not a Pyomo component)
+    return m
+
+
+# ---------------------------------------------------------------- reading solutions and cuts
+
+
+def _values(var) -> dict:
+    return {k: (v.value if v.value is not None else 0.0) for k, v in var.items()}
+
+
+def _routes(g: ArcGraph, xval: dict) -> tuple[list[list[int]], set[int], dict[int, int]]:
+    """Routes (solver indices) followed from the start, nodes left on subtours, successor map."""
+    succ: dict[int, int] = {}
+    for (i, j), v in xval.items():
+        if v > 0.5:
+            succ.setdefault(i, j)  # an integer solution has one out-arc per visited node
+    firsts = [j for (i, j), v in xval.items() if i == g.start and v > 0.5]
+    routes, seen = [], set()
+    for j in firsts:
+        route = []
+        while j != g.end and j not in seen:
+            seen.add(j)
+            route.append(j)
+            j = succ.get(j, g.end)
+        routes.append(route)
+    stray = {i for i in succ if i != g.start and i not in seen}
+    return routes, stray, succ
+
+
+def _cycles(stray: set[int], succ: dict[int, int]) -> list[list[int]]:
+    cycles, left = [], set(stray)
+    while left:
+        i = min(left)
+        cyc = []
+        while i in left:
+            left.discard(i)
+            cyc.append(i)
+            i = succ.get(i, -1)
+        cycles.append(cyc)
+    return cycles
+
+
+def _add_connectivity_cut(m, subset: set[int]) -> None:
+    """sum of x over arcs entering S >= y_k for every k in S (S contains no depot)."""
+    inflow = [a for a in m.A if a[1] in subset and a[0] not in subset]
+    for k in subset:
+        m.cuts.add(sum(m.x[a] for a in inflow) >= m.y[k])
+
+
+def _separate_lp(m, g: ArcGraph, xval: dict, yval: dict, max_cuts: int = 40) -> int:
+    """Connectivity cuts violated by a fractional point: min start→k cut < y_k (max-flow)."""
+    size = g.n_nodes + 2
+    scale = 1_000_000
+    rows, cols, caps = [], [], []
+    for (i, j), v in xval.items():
+        c = int(v * scale)
+        if c > 0:
+            rows.append(i)
+            cols.append(j)
+            caps.append(c)
+    if not caps:
+        return 0
+    cap = csr_matrix((np.array(caps, dtype=np.int32), (rows, cols)), shape=(size, size))
+    added, covered = 0, set()
+    order = sorted(g.nodes, key=lambda k: -yval[k])
+    for k in order:
+        if added >= max_cuts or yval[k] < _CUT_TOL or k in covered:
+            continue
+        res = maximum_flow(cap, g.start, k)
+        if res.flow_value >= (yval[k] - _CUT_TOL) * scale:
+            continue
+        # source side of the min cut: reachable from the start in the residual graph
+        residual = (cap - res.flow).tocsr()
+        residual.data = np.where(residual.data > 0, residual.data, 0)
+        residual.eliminate_zeros()
+        reach = {g.start}
+        stack = [g.start]
+        while stack:
+            u = stack.pop()
+            for w in residual.indices[residual.indptr[u]:residual.indptr[u + 1]]:
+                if w not in reach:
+                    reach.add(int(w))
+                    stack.append(int(w))
+        subset = {i for i in g.nodes if i not in reach}
+        if k not in subset:
+            continue
+        _add_connectivity_cut(m, subset)
+        covered |= subset
+        added += 1
+    return added
+
+
+def _separate_cliques(m, g: ArcGraph, inc: np.ndarray, yval: dict, xval: dict, n_vehicles: int) -> int:
+    """Clique inequalities violated by a fractional point, grown greedily by LP weight."""
+    w = np.array([yval[i] for i in g.nodes])
+    used = sum(v for (i, _), v in xval.items() if i == g.start)
+    have = {tuple(sorted(c)) for c in getattr(m, "_clique_sets", [])}
+    added = 0
+    for cl in incompatible_cliques(g, n_vehicles, weights=w, inc=inc):
+        if cl in have or sum(yval[i] for i in cl) <= used + _CUT_TOL:
+            continue
+        m.cuts.add(sum(m.y[i] for i in cl) <= sum(m.x[a] for a in m.A if a[0] == g.start))
+        have.add(cl)
+        added += 1
+    m._clique_sets = list(have)
+    return added
+
+
+# ---------------------------------------------------------------- the solve loop
+
+
+@dataclass
+class _Best:
+    plan: Plan | None = None
+    prize: float = -math.inf
+
+
+def _to_plan(routes: list[list[int]]) -> Plan:
+    return Plan.of([[i - 1 for i in r] for r in routes if r])
+
+
+def _set_warm_start(opt, m, plan: Plan, g: ArcGraph) -> bool:
+    """Give HiGHS a starting solution (x, y, z) built from ``plan``; False if it does not fit."""
+    x = {a: 0.0 for a in m.A}
+    z = {a: 0.0 for a in m.A}
+    y = {i: 0.0 for i in m.N}
+    for route in plan.routes:
+        if not route:
+            continue
+        path = [g.start] + [v + 1 for v in route] + [g.end]
+        used = 0.0
+        for i, j in zip(path, path[1:]):
+            if (i, j) not in x:
+                return False
+            used += float(g.cost[i, j])
+            x[i, j] = 1.0
+            z[i, j] = used
+            if j != g.end:
+                y[j] = 1.0
+    colmap = getattr(opt, "_pyomo_var_to_solver_var_map", None)
+    if colmap is None:  # private attribute of Pyomo's HiGHS interface; skip if it changes
+        return False
+    idx, val = [], []
+    for var, vals in ((m.x, x), (m.y, y), (m.z, z)):
+        for k, v in vals.items():
+            idx.append(colmap[id(var[k])])
+            val.append(v)
+    opt._solver_model.setSolution(len(idx), np.array(idx, dtype=np.int32), np.array(val, dtype=float))
+    return True
+
+
+def solve_milp(
+    instance: TOPInstance,
+    *,
+    seed: int = 0,
+    time_limit: float | None = 60.0,
+    threads: int = 1,
+    warm_start: Plan | None = None,
+    root_rounds: int = 10,
+    two_cycle: bool = True,
+    cliques: bool = True,
+    paths: bool = True,
+    tee: bool = False,
+) -> Result:
+    """Solve ``instance`` exactly with HiGHS (see the module docstring for the method).
+
+    ``warm_start``: a valid plan handed to HiGHS as its first incumbent (formulations cannot import
+    heuristics; the registered ``milp`` method in :mod:`heuristics.exact` passes greedy's plan).
+    ``root_rounds``: rounds of LP connectivity-cut separation before the MIP (0 turns it off).
+    Returns OPTIMAL only when the verified plan reaches HiGHS's proven bound.
+    """
+    t0 = time.perf_counter()
+    deadline = None if time_limit is None else t0 + float(time_limit)
+    info: dict = {"threads": threads, "seed": seed}
+
+    def left() -> float | None:
+        return None if deadline is None else max(deadline - time.perf_counter(), 0.0)
+
+    def done(status, plan=None, bound=None, reason=""):
+        info["runtime_model_s"] = round(time.perf_counter() - t0, 4)
+        return Result(METHOD, status, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
+                      reason=reason, info=info)
+
+    reason = precheck(instance)
+    if reason is not None:
+        return done(Status.INFEASIBLE, reason=reason)
+    g = prune_arcs(instance)
+    info.update(nodes=len(g.nodes), arcs=len(g.arcs), arcs_full=g.n_arcs_full)
+    if not g.nodes:  # nothing reachable; precheck passed, so there are no groups
+        return done(Status.OPTIMAL, plan=Plan.of([]), bound=0.0, reason="no node is reachable within the budget")
+    lattice = prize_lattice(instance.prizes[[i - 1 for i in g.nodes]])
+    m = build_milp(instance, g, two_cycle=two_cycle, cliques=cliques, paths=paths)
+
+    opt = SolverFactory("highs")
+    options = {
+        "mip_rel_gap": 0.0,
+        "mip_abs_gap": 0.5 * lattice if lattice else 1e-9,
+        "random_seed": int(seed),
+        "threads": int(threads),
+        "output_flag": bool(tee),
+    }
+    common = dict(raise_exception_on_nonoptimal_result=False, load_solutions=False, tee=tee,
+                  solver_options=options)
+
+    # Every bound seen is valid (each model relaxes the problem); keep the smallest. The trivial
+    # one: every reachable node visited.
+    bound = floor_to_lattice(float(sum(instance.prizes[i - 1] for i in g.nodes)), lattice)
+
+    # Root cut loop on the LP relaxation: connectivity cuts the time flow leaves violated.
+    cuts_lp, cuts_clique = 0, 0
+    inc = incompatibility(g) if cliques else None
+    if root_rounds > 0:
+        for v in m.x.values():
+            v.domain = pyo.UnitInterval
+        for v in m.y.values():
+            v.domain = pyo.UnitInterval
+        lp_bounds = []
+        for _ in range(root_rounds):
+            if left() is not None and left() < 1.0:
+                break
+            res = opt.solve(m, time_limit=left(), **common)
+            if res.termination_condition != TerminationCondition.convergenceCriteriaSatisfied:
+                break
+            res.solution_loader.load_vars()
+            lp_bounds.append(round(float(res.incumbent_objective), 6))
+            bound = min(bound, floor_to_lattice(float(res.incumbent_objective), lattice))
+            xval, yval = _values(m.x), _values(m.y)
+            n = _separate_lp(m, g, xval, yval)
+            if cliques:
+                nc = _separate_cliques(m, g, inc, yval, xval, instance.n_vehicles)
+                cuts_clique += nc
+                n += nc
+            cuts_lp += n
+            if n == 0:
+                break
+        for v in m.x.values():
+            v.domain = pyo.Binary
+        for v in m.y.values():
+            v.domain = pyo.Binary
+        info["lp_bounds"] = lp_bounds
+    info["cuts_lp"] = cuts_lp
+    info["cuts_clique"] = cuts_clique
+
+    best = _Best()
+    rounds, cuts_int, nogoods, warm = 0, 0, 0, False
+    while True:
+        rounds += 1
+        tl = left()
+        if tl is not None and tl <= 0.0:
+            status = Status.TIME_LIMIT
+            break
+        if rounds == 1 and warm_start is not None:
+            opt.set_instance(m)
+            warm = _set_warm_start(opt, m, warm_start, g)
+        res = opt.solve(m, time_limit=tl, **common)
+        tc = res.termination_condition
+        info["highs_termination"] = str(tc.name)
+        info["mip_nodes"] = getattr(res.extra_info, "mip_node_count", None)
+        if tc in (TerminationCondition.provenInfeasible, TerminationCondition.infeasibleOrUnbounded):
+            # The model is bounded (binaries, bounded flow), so "infeasible or unbounded" is infeasible.
+            info.update(rounds=rounds, cuts_int=cuts_int, nogoods=nogoods, warm_start=warm)
+            what = "target" if instance.kind == "sar" else "group"
+            return done(Status.INFEASIBLE,
+                        reason=f"HiGHS proved that no plan of {instance.n_vehicles} routes within the "
+                               f"budget covers every {what}")
+        if res.objective_bound is not None and math.isfinite(res.objective_bound):
+            bound = min(bound, floor_to_lattice(float(res.objective_bound), lattice))
+        if tc not in (TerminationCondition.convergenceCriteriaSatisfied, TerminationCondition.maxTimeLimit):
+            info.update(rounds=rounds)
+            return done(Status.ERROR, plan=best.plan, bound=bound, reason=f"HiGHS stopped: {tc.name}")
+        if res.incumbent_objective is None:
+            status = Status.TIME_LIMIT
+            break
+        res.solution_loader.load_vars()
+        xval = _values(m.x)
+        routes, stray, succ = _routes(g, xval)
+        plan = _to_plan(routes)
+        report = verify(instance, plan)
+        if report.valid and report.prize > best.prize:
+            best = _Best(plan, report.prize)
+        changed = False
+        if stray:  # subtours among coincident points: cut them off and re-solve
+            for cyc in _cycles(stray, succ):
+                _add_connectivity_cut(m, set(cyc))
+                cuts_int += 1
+            changed = True
+        for r, route in enumerate(routes):
+            if route and not (report.energy[r] <= g.budget):
+                # HiGHS accepted this route within its tolerance; the verifier does not. It is
+                # infeasible, so cutting off exactly its arcs keeps every feasible plan.
+                path = [g.start, *route, g.end]
+                arcs = list(zip(path, path[1:]))
+                m.cuts.add(sum(m.x[a] for a in arcs) <= len(arcs) - 1)
+                nogoods += 1
+                changed = True
+        if changed:
+            continue
+        status = Status.OPTIMAL if tc == TerminationCondition.convergenceCriteriaSatisfied else Status.TIME_LIMIT
+        break
+
+    info.update(rounds=rounds, cuts_int=cuts_int, nogoods=nogoods, warm_start=warm)
+    if best.plan is None and warm_start is not None and verify(instance, warm_start).valid:
+        best = _Best(warm_start, verify(instance, warm_start).prize)
+    if best.plan is not None and best.prize >= bound - 1e-7 * max(1.0, abs(bound)):
+        return done(Status.OPTIMAL, plan=best.plan, bound=bound)  # a verified plan reaches a proven bound
+    if status == Status.OPTIMAL:  # HiGHS optimal, yet the verified plan is below its bound: never claim it
+        return done(Status.FEASIBLE, plan=best.plan, bound=bound,
+                    reason="HiGHS reported optimal but the verified plan does not reach its bound")
+    return done(Status.TIME_LIMIT, plan=best.plan, bound=bound, reason="time limit")
