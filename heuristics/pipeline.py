@@ -72,6 +72,8 @@ def cluster_then_route(
         return Result(name, Status.FEASIBLE, plan=empty, runtime_s=time.perf_counter() - t0, info=info)
 
     k = min(instance.n_vehicles, reach.size)
+    if clusterer == "kmeans":  # KMeans cannot make more clusters than distinct points
+        k = min(k, np.unique(instance.coords[reach], axis=0).shape[0])
     labels = make_clusterer(clusterer, k, instance, seed).fit(instance.coords[reach]).labels_
     clusters = [reach[labels == c] + 1 for c in range(k)]  # solver indices
     info["cluster_sizes"] = [int(c.size) for c in clusters]

@@ -32,14 +32,6 @@ class RepairFailed(Exception):
     """No plan covering every group was found; the message names the group."""
 
 
-def _ratio(prizes: np.ndarray):
-    def score(delta: np.ndarray, nodes: np.ndarray) -> np.ndarray:
-        p = prizes[nodes - 1][:, None]
-        return np.where(delta > 1e-12, p / np.maximum(delta, 1e-12), np.inf * (p > 0))
-
-    return score
-
-
 class Repairer:
     """Repairs lists of routes (solver indices) for one instance; reuses its matrices."""
 
@@ -91,39 +83,92 @@ class Repairer:
         return rs
 
     def _cover(self, rs: RouteSet, reach: np.ndarray) -> int | None:
-        """Insert a view of each uncovered group; return a group that cannot be, or None."""
+        """Insert a view of each uncovered group; return a group that cannot be, or None.
+
+        Greedy's group phase, hardest group first: the group whose cheapest feasible insertion
+        is most expensive goes in first, at that place. Insertion costs are kept per route and
+        only the route that changed is re-scored each round.
+        """
         inst = self.instance
         covered = np.zeros(len(inst.groups), dtype=bool)
         g = self.group[rs.visited]
         covered[g[g >= 0]] = True
-        uncovered = [gi for gi in range(len(inst.groups)) if not covered[gi]]
-        while uncovered:
-            choice = None
-            for gi in uncovered:
-                nodes = np.array([v + 1 for v in inst.groups[gi]], dtype=int)
-                nodes = nodes[reach[nodes]]
-                best = rs.best_insertion(nodes)
-                if best is None:
-                    return gi
-                if choice is None or best[0] < choice[1][0]:  # hardest group first
-                    choice = (gi, best)
-            gi, (_, node, r, p, delta) = choice
-            rs.insert(node, r, p, delta)
-            uncovered.remove(gi)
+        cand = np.array([v + 1 for gi in np.flatnonzero(~covered) for v in inst.groups[gi]], dtype=int)
+        cand = cand[reach[cand]] if cand.size else cand
+        gid = self.group[cand]
+        missing = np.flatnonzero(~covered)
+        lost = np.setdiff1d(missing, gid)
+        if lost.size:
+            return int(lost[0])
+        if missing.size == 0:
+            return None
+        R = len(rs.routes)
+        cost = np.full((R, cand.size), np.inf)
+        where = np.zeros((R, cand.size), dtype=int)
+
+        def score(r):
+            delta = rs.insertion_deltas(r, cand)
+            delta = np.where(rs.energy[r] + delta <= rs.limit, delta, np.inf)
+            where[r] = np.argmin(delta, axis=1)
+            cost[r] = delta[np.arange(cand.size), where[r]]
+
+        for r in range(R):
+            score(r)
+        alive = np.ones(cand.size, dtype=bool)
+        while alive.any():
+            best = np.where(alive, cost.min(axis=0), np.inf)  # per candidate, over routes
+            group_best = np.full(len(inst.groups), -np.inf)
+            np.maximum.at(group_best, gid[alive], -best[alive])  # -(cheapest) per group
+            open_groups = np.unique(gid[alive])
+            hardest = open_groups[np.argmin(group_best[open_groups])]
+            if not np.isfinite(group_best[hardest]):
+                return int(hardest)
+            mine = np.flatnonzero(alive & (gid == hardest))
+            c = mine[np.argmin(best[mine])]
+            r = int(np.argmin(cost[:, c]))
+            rs.insert(int(cand[c]), r, int(where[r, c]), float(cost[r, c]))
+            alive &= gid != hardest
+            score(r)
         return None
 
     def _fill(self, rs: RouteSet, reach: np.ndarray) -> int:
-        score = _ratio(self.instance.prizes)
+        """Insert free reachable viewpoints by greatest prize per added energy while any fits.
+
+        Same rule as greedy's second phase; scores are kept per route and only the route that
+        changed is re-scored each round.
+        """
+        cand = np.flatnonzero(reach & ~rs.visited)
+        cand = cand[self.prize[cand] > 0]
+        if cand.size == 0:
+            return 0
+        p = self.prize[cand][:, None]
+        R = len(rs.routes)
+        value = np.full((R, cand.size), -np.inf)
+        where = np.zeros((R, cand.size), dtype=int)
+        delta_at = np.zeros((R, cand.size))
+
+        def score(r):
+            delta = rs.insertion_deltas(r, cand)
+            v = np.where(delta > 1e-12, p / np.maximum(delta, 1e-12), np.inf)
+            v = np.where(rs.energy[r] + delta <= rs.limit, v, -np.inf)
+            where[r] = np.argmax(v, axis=1)
+            rows = np.arange(cand.size)
+            value[r] = v[rows, where[r]]
+            delta_at[r] = delta[rows, where[r]]
+
+        for r in range(R):
+            score(r)
+        alive = np.ones(cand.size, dtype=bool)
         added = 0
         while True:
-            free = np.flatnonzero(reach & ~rs.visited)
-            free = free[self.prize[free] > 0]
-            best = rs.best_insertion(free, score)
-            if best is None:
+            masked = np.where(alive[None, :], value, -np.inf)
+            r, c = np.unravel_index(int(np.argmax(masked)), masked.shape)
+            if masked[r, c] == -np.inf:
                 return added
-            _, node, r, p, delta = best
-            rs.insert(node, r, p, delta)
+            rs.insert(int(cand[c]), int(r), int(where[r, c]), float(delta_at[r, c]))
+            alive[c] = False
             added += 1
+            score(int(r))
 
     def repair(self, routes: list[list[int]], reinsert: bool = True) -> list[list[int]]:
         """Feasible routes (solver indices) covering every group; raises RepairFailed."""

@@ -11,6 +11,7 @@ length is ``path_lengths`` with ``D[end, end] = 0`` absorbing the pads.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -86,6 +87,15 @@ class ClusterBatch:
         return out
 
 
+@lru_cache(maxsize=256)
+def _pairs(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Index pairs (i, j), j >= i + 2, of the edges 0..n-1 of a path (read-only arrays)."""
+    i, j = np.triu_indices(n, k=2)
+    i.setflags(write=False)
+    j.setflags(write=False)
+    return i, j
+
+
 def invert(perm: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """Reverse perm[r, lo[r]:hi[r]+1] in every row (lo > hi leaves the row unchanged)."""
     idx = np.arange(perm.shape[1])[None, :]
@@ -102,7 +112,7 @@ def best_two_opt_moves(D: np.ndarray, seqs: np.ndarray, sizes: np.ndarray, start
     """
     R, L = seqs.shape
     full = np.concatenate([np.full((R, 1), start), seqs, np.full((R, 1), end)], axis=1)
-    i, j = np.triu_indices(L + 1, k=2)  # edge i = (full[i], full[i+1])
+    i, j = _pairs(L + 1)  # edge i = (full[i], full[i+1])
     a, b, c, d = full[:, i], full[:, i + 1], full[:, j], full[:, j + 1]
     gain = D[a, b] + D[c, d] - D[a, c] - D[b, d]
     gain = np.where(j[None, :] <= sizes[:, None], gain, -np.inf)  # stay inside the real part
@@ -123,7 +133,7 @@ def two_opt(D: np.ndarray, route, start: int, end: int, max_moves: int = 1000) -
     if n < 2:
         return route
     seq = np.concatenate(([start], route, [end]))
-    i, j = np.triu_indices(n + 1, k=2)  # edges (seq[i], seq[i+1]) and (seq[j], seq[j+1])
+    i, j = _pairs(n + 1)  # edges (seq[i], seq[i+1]) and (seq[j], seq[j+1])
     for _ in range(max_moves):
         a, b, c, d = seq[i], seq[i + 1], seq[j], seq[j + 1]
         delta = D[a, c] + D[b, d] - D[a, b] - D[c, d]
