@@ -418,6 +418,16 @@ def run_one_guarded(job: dict) -> dict:
                                          f"+ grace {job['grace']:g} s; Dask cannot kill the thread)", elapsed)
 
 
+def connect(address: str):
+    """A Dask Client for ``address``; a one-line HarnessError when the scheduler is unreachable."""
+    from dask.distributed import Client
+
+    try:
+        return Client(address, timeout="15s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise HarnessError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
+
+
 def run_dask(jobs: list[dict], emit, *, scheduler) -> None:
     """Run ``jobs`` on a Dask cluster (an address like ``tcp://host:8786`` or a Client)."""
     if not jobs:
@@ -425,13 +435,7 @@ def run_dask(jobs: list[dict], emit, *, scheduler) -> None:
     from dask.distributed import Client, as_completed
 
     own = not isinstance(scheduler, Client)
-    if own:
-        try:
-            client = Client(scheduler, timeout="15s")
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise HarnessError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
-    else:
-        client = scheduler
+    client = connect(scheduler) if own else scheduler
     try:
         futures = {}
         for job in jobs:
@@ -461,6 +465,15 @@ def run_suite(suite: Suite, out_dir: str | Path, *, workers: int | None = None, 
               scheduler=None, progress: bool = True, stream=None) -> dict:
     """Run every job of ``suite`` not yet stored in ``out_dir``; return a summary dict."""
     workers = workers or default_workers()
+    client = connect(scheduler) if isinstance(scheduler, str) else None  # fail before touching out_dir
+    try:
+        return _run_suite(suite, out_dir, workers, resume, client or scheduler, scheduler, progress, stream)
+    finally:
+        if client is not None:
+            client.close()
+
+
+def _run_suite(suite, out_dir, workers, resume, scheduler, address, progress, stream) -> dict:
     store = ResultsStore(out_dir, resume=resume)
     stream = stream or sys.stderr
     try:
@@ -471,7 +484,7 @@ def run_suite(suite: Suite, out_dir: str | Path, *, workers: int | None = None, 
         stored = len(suite.jobs) - len(todo)
         if store.repaired and progress:
             stream.write(f"{store.path}: dropped a half-written last row (a job in flight when the run was killed)\n")
-        where = f"Dask at {scheduler if isinstance(scheduler, str) else 'client'}" if scheduler else f"{workers} workers"
+        where = f"Dask at {address if isinstance(address, str) else 'client'}" if scheduler else f"{workers} workers"
         if progress:
             stream.write(f"suite {suite.name}: {len(suite.jobs)} jobs ({suite.n_instances} instances × "
                          f"{len(suite.methods)} methods), {stored} already stored, {len(todo)} to run on {where}\n")
@@ -492,7 +505,8 @@ def run_suite(suite: Suite, out_dir: str | Path, *, workers: int | None = None, 
         with (store.directory / "runs.jsonl").open("a") as fh:
             fh.write(json.dumps({"suite": suite.name, "started_at": started, "finished_at": _now(),
                                  "wall_s": wall, "jobs": len(todo), "already_stored": stored,
-                                 "workers": workers, "scheduler": scheduler if isinstance(scheduler, str) else None,
+                                 "workers": None if scheduler else workers,
+                                 "scheduler": address if isinstance(address, str) else None,
                                  "command": shlex.join(sys.argv), **environment()}) + "\n")
         return {"suite": suite.name, "jobs": len(suite.jobs), "ran": len(todo), "stored_before": stored,
                 "wall_s": wall, "counts": dict(bar.counts), "path": str(store.path)}
