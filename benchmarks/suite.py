@@ -200,6 +200,8 @@ def _build(data: dict, path: Path, text: str, runs_override: int | None) -> Suit
                     key = f"{inst_id}|{m}|{s}"
                     jobs.setdefault(key, Job(key, inst_id, m, s, run * opt["seeds"] + s, tl, grace,
                                              {**source, "exact": exact[m]}))
+    if runs_override is not None and all("files" in spec for spec in sets):
+        raise SuiteError(f"{where}: --runs sets the random instances per setting, and this suite has only files")
     return Suite(name, path, text, str(data.get("description", "")), methods, list(jobs.values()), memory_mb)
 
 

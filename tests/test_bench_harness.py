@@ -260,7 +260,7 @@ def test_builtin_suites_load_with_registered_methods():
 
     assert {"quick", "exact-small", "paper-n", "paper-k", "top-chao"} <= set(builtin_suites())
     for name in builtin_suites():
-        suite = load_suite(name, runs=2)
+        suite = load_suite(name, runs=None if name == "top-chao" else 2)
         assert suite.jobs, name
     paper_n = load_suite("paper-n", runs=2)
     assert {(j.source["M"], j.source["K"], j.source["N"]) for j in paper_n.jobs} == {(20, 3, n) for n in range(2, 7)}
