@@ -123,3 +123,12 @@ def test_general_top_with_distinct_end():
         result, report = run_method(name, inst)
         assert result.status == Status.FEASIBLE and report.valid and report.prize > 0
         assert verify(inst, result.plan).valid
+
+
+@pytest.mark.parametrize("name", PIPELINES)
+def test_expired_time_limit_still_gives_a_verified_plan(name):
+    """A time limit that expires at once stops the routers early; the repaired plan still verifies."""
+    inst = to_top(generate(20, 3, 5, seed=4))
+    result, report = run_method(name, inst, seed=0, time_limit=1e-9)
+    assert result.status == Status.FEASIBLE and report.valid
+    assert result.info["stopped_by_time"] is True
