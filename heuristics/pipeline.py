@@ -44,6 +44,20 @@ def make_clusterer(kind: str, n_clusters: int, instance: TOPInstance, seed: int)
     raise ValueError(f"unknown clusterer {kind!r}")
 
 
+_CONTROLLER = None
+
+
+def _one_openmp_thread():
+    """Context limiting OpenMP (scikit-learn's KMeans) to one thread; the controller is cached
+    because building it scans the loaded libraries (about 3 ms a call)."""
+    global _CONTROLLER
+    if _CONTROLLER is None:
+        from threadpoolctl import ThreadpoolController
+
+        _CONTROLLER = ThreadpoolController()
+    return _CONTROLLER.limit(limits=1, user_api="openmp")
+
+
 ROUTERS: dict[str, Callable[[], object]] = {"pso": PSORouter, "ga": GARouter, "aco": ACORouter}
 
 
@@ -74,7 +88,12 @@ def cluster_then_route(
     k = min(instance.n_vehicles, reach.size)
     if clusterer == "kmeans":  # KMeans cannot make more clusters than distinct points
         k = min(k, np.unique(instance.coords[reach], axis=0).shape[0])
-    labels = make_clusterer(clusterer, k, instance, seed).fit(instance.coords[reach]).labels_
+    model = make_clusterer(clusterer, k, instance, seed)
+    if clusterer == "kmeans":  # one thread like everything else (OpenMP spinning triples CPU time)
+        with _one_openmp_thread():
+            labels = model.fit(instance.coords[reach]).labels_
+    else:
+        labels = model.fit(instance.coords[reach]).labels_
     clusters = [reach[labels == c] + 1 for c in range(k)]  # solver indices
     info["cluster_sizes"] = [int(c.size) for c in clusters]
     t1 = time.perf_counter()
