@@ -55,7 +55,7 @@ _SPECS = [
                "OR-Tools routing, prize disjunctions + energy dimension, guided local search, <=10 s"),
     MethodSpec("pyvrp", "heuristics.pyvrp_method:pyvrp", False,
                "PyVRP iterated local search, optional clients with prizes, max distance = energy, 2000 its"),
-    MethodSpec("milp", "formulations.milp:solve_milp", True,
+    MethodSpec("milp", "heuristics.milp_warm:milp", True,
                "time-flow TOP MILP on HiGHS via Pyomo: pruned arcs, cliques, path + connectivity cuts, 1 thread, gap 0"),
     MethodSpec("bp", "formulations.bp:solve_bp", True,
                "branch-and-price: route master on HiGHS, ng-route labelling pricing (numba), 1 thread"),

@@ -186,6 +186,13 @@ def test_warm_start_plan_is_kept_when_nothing_better_is_found():
     assert result.info["warm_start"] is True
 
 
+def test_registered_method_starts_from_greedy():
+    """The registered `milp` hands greedy's plan to HiGHS and still proves the optimum."""
+    result, _ = solve(top([[1, 0], [2, 0], [3, 0]], [1, 1, 5], 4.0))
+    assert result.info["warm_start"] is True and result.info["warm_start_prize"] is not None
+    assert result.status == Status.OPTIMAL and result.objective == 2
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(PUBLISHED))
 def test_top_sets_1_to_3(name):
