@@ -8,6 +8,9 @@ last may one be removed, which uncovers that group. After each removal the route
 by 2-opt. Then:
 
 1. every uncovered group gets its cheapest feasible insertion (hardest group first, as greedy);
+   a group that fits nowhere gets room made in one route: views of groups that stay covered
+   are dropped there by the rule above until one of its views fits, choosing the route and view
+   that lose the least prize (``info["made_room"]`` counts these);
 2. if some group still cannot be inserted, every route is stripped to one viewpoint per group it
    covers (the groups' "last views"), 2-opted, and step 1 is retried; if that fails too, the
    routes are rebuilt from empty by step 1 alone (greedy's group phase, ``info["rebuilt"]``);
@@ -170,6 +173,53 @@ class Repairer:
             added += 1
             score(int(r))
 
+    def _make_room(self, rs: RouteSet, gi: int, reach: np.ndarray) -> bool:
+        """Fit a view of uncovered group ``gi`` into one route by dropping views of covered groups.
+
+        For every route and every reachable view v of the group: drop, by the shrink rule
+        (greatest saving per prize), views whose group keeps another visited view, until v's
+        cheapest insertion fits. The (route, v) losing the least prize is applied. False if no
+        route can make room.
+        """
+        count = np.bincount(self.group[rs.visited & (self.group >= 0)], minlength=len(self.instance.groups))
+        nodes = [v + 1 for v in self.instance.groups[gi] if reach[v + 1]]
+        best = None
+        for r, route in enumerate(rs.routes):
+            for v in nodes:
+                trial, lost, left = list(route), 0.0, count.copy()
+                while True:
+                    seq = np.array([0, *trial, self.end])
+                    delta = self.C[seq[:-1], v] + self.C[v, seq[1:]] - self.C[seq[:-1], seq[1:]]
+                    pos = int(np.argmin(delta))
+                    if self.energy(trial) + delta[pos] <= self.limit:
+                        if best is None or lost < best[0]:
+                            best = (lost, r, trial[:pos] + [v] + trial[pos:])
+                        break
+                    if not trial:
+                        break
+                    prev, node, nxt = seq[:-2], seq[1:-1], seq[2:]
+                    g = self.group[node]
+                    droppable = (g < 0) | (left[np.maximum(g, 0)] > 1)
+                    if not droppable.any():
+                        break
+                    saving = self.C[prev, node] + self.C[node, nxt] - self.C[prev, nxt]
+                    p = self.prize[node]
+                    score = np.where(p > 0, saving / np.maximum(p, 1e-300), np.inf)
+                    k = int(np.argmax(np.where(droppable, score, -np.inf)))
+                    lost += float(p[k])
+                    if g[k] >= 0:
+                        left[g[k]] -= 1
+                    trial.pop(k)
+        if best is None:
+            return False
+        _, r, route = best
+        rs.visited[rs.routes[r]] = False
+        rs.routes[r] = route
+        rs.visited[route] = True
+        rs.energy[r] = self.energy(route)
+        self.stats["made_room"] = self.stats.get("made_room", 0) + 1
+        return True
+
     def repair(self, routes: list[list[int]], reinsert: bool = True) -> list[list[int]]:
         """Feasible routes (solver indices) covering every group; raises RepairFailed."""
         inst = self.instance
@@ -187,6 +237,8 @@ class Repairer:
         reach[1:-1] = inst.reachable()
         rs = self._routeset(fixed)
         missing = self._cover(rs, reach)
+        while missing is not None and self._make_room(rs, missing, reach):
+            missing = self._cover(rs, reach)
         if missing is not None:
             self.stats["stripped"] = True
             stripped = []
