@@ -46,6 +46,8 @@ from formulations.verify import verify
 
 DEFAULT_TIME_CAP = 10.0  # seconds, when no time limit is given
 SOLUTION_LIMIT = 1000  # local-search solutions; the reproducible stop (~1-10 s at 60 nodes)
+METAHEURISTIC = "GUIDED_LOCAL_SEARCH"
+GLS_LAMBDA = 10.0  # OR-Tools default 0.1; 10 cut the mean TOP gap from 5 % to 0.3-0.7 % (16 files, 3 s)
 TIEBREAK_UNITS = 1000  # travel cost units per E_max in the objective (tie-break only)
 
 
@@ -128,7 +130,9 @@ def solve_routing(
 
     params = pywrapcp.DefaultRoutingSearchParameters()
     params.first_solution_strategy = routing_enums_pb2.FirstSolutionStrategy.LOCAL_CHEAPEST_INSERTION
-    params.local_search_metaheuristic = routing_enums_pb2.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH
+    params.local_search_metaheuristic = getattr(routing_enums_pb2.LocalSearchMetaheuristic, METAHEURISTIC)
+    if METAHEURISTIC == "GUIDED_LOCAL_SEARCH":
+        params.guided_local_search_lambda_coefficient = GLS_LAMBDA
     remaining = max(cap - (time.perf_counter() - t0), 0.01)
     params.time_limit.FromMilliseconds(max(int(remaining * 1000), 10))
     params.log_search = False
