@@ -27,7 +27,7 @@ def test_bench_build_milp(benchmark, name):
     assert len(model.x) > 0
 
 
-@pytest.mark.parametrize("name", ["p2.2.k", "p1.2.g", "p3.3.e"])
+@pytest.mark.parametrize("name", ["p2.2.f", "p1.2.g", "p3.2.d"])
 def test_bench_solve_milp(benchmark, name):
     """Time to proven optimality, one thread."""
     inst = read_top(TOP_DIR / f"{name}.txt")
