@@ -30,13 +30,13 @@ expansion index. A cluster starts with its centre, so ω_i ≥ 1 and ω_i = 0 ne
 energy flying out, not imaging.
 
 Defaults, tuned on the paper preset (M=20, K=3, N=5, seeds 0-49, ``adpc-pso``, mean coverage
-with refill / without the repair's refill step)::
+with / without the repair's refill step)::
 
-    ξ  |  d_c percentile   1 %            2 %            5 %
-    0    (nearest centre)   0.766/0.667    0.767/0.683    0.780/0.702
-    0.25                    0.755/0.696    0.757/0.685    0.765/0.696
-    0.5                     0.742/0.644    0.740/0.659    0.749/0.687
-    1                       0.714/0.586    0.710/0.573    0.717/0.598
+    ξ  |  d_c percentile   2 %            5 %
+    0    (nearest centre)   0.769/0.716    0.779/0.725
+    0.25                    0.761/0.710    0.769/0.720
+    0.5                     0.741/0.685    0.748/0.691
+    1                       0.708/0.611    0.716/0.624
 
 The size penalty costs coverage on this preset (imaging is expensive, E_I = 150 m of flight, so
 the big near-base clusters it creates overflow their budget); ξ = 0.25 keeps the paper's idea at
