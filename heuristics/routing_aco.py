@@ -28,7 +28,7 @@ _PAD = -1e300
 # Weight of a pad: absorbed in the wheel's total (≥ 1e-20 while real viewpoints remain, since
 # the weights are normalised per row and floored), so a pad is drawn only once a row's viewpoints are done.
 # Real weights are floored at 1e-20 (float32 keeps them apart from pads) before normalisation.
-_PAD_WEIGHT = 1e-38
+_PAD_WEIGHT = 1e-30  # normal in float32 (subnormals are slow), absorbed next to 1e-20
 _MIN_WEIGHT = 1e-20
 
 
