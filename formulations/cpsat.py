@@ -159,6 +159,8 @@ class _Model:
                 self.m.add_bool_or([])  # unreachable group: infeasible (precheck catches it first)
             else:
                 self.m.add_bool_or(lits)
+        if isinstance(obj, int):  # no positive prize among the reachable nodes
+            obj = 0 * self.visit[1]
         if objective_cap is not None:
             self.m.add(obj <= objective_cap)
         self.m.maximize(obj)
@@ -382,8 +384,10 @@ def solve_cpsat(
         if hint is not None and verify(instance, hint).valid:
             return done(Status.TIME_LIMIT, hint, None, reason="time limit; CP-SAT found no plan, the hint is returned")
         return done(Status.TIME_LIMIT, reason=f"CP-SAT found no plan ({solver.status_name(st)})")
-    ibound = int(round(solver.best_objective_bound)) if st == cp_model.FEASIBLE else int(round(solver.objective_value))
-    ibound = max(ibound, int(round(solver.objective_value)))
+    ivalue = int(round(solver.objective_value))
+    # Integer objective: CP-SAT's bound is integral; ceil(x - 1e-6) never rounds it down.
+    ibound = math.ceil(solver.best_objective_bound - 1e-6) if st == cp_model.FEASIBLE else ivalue
+    ibound = max(ibound, ivalue)
     bound = ibound / pscale
     routes = built.routes(solver)
     plan = _pad(routes, instance.n_vehicles)

@@ -176,3 +176,9 @@ ALL_TOP = sorted(n for n in PUBLISHED if n.split(".")[0] in ("p1", "p2", "p3"))
 def test_top_sets_1_to_3_never_wrong(name):
     """Sets 1-3 at 60 s: every 'optimal' equals the published value, every bound is above it."""
     _check_top(name, 60.0)
+
+
+def test_zero_prizes_with_group():
+    """All prizes zero but a group to cover: a valid plan of value 0, proven optimal."""
+    res, rep = solve(top(LINE, [0, 0, 0], 4.0, groups=((1,),)))
+    assert res.status == Status.OPTIMAL and res.objective == 0.0 and rep.groups_covered == 1
