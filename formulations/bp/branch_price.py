@@ -73,7 +73,8 @@ class _Stats:
 
 class BranchAndPrice:
     def __init__(self, instance: TOPInstance, *, time_limit: float | None, ng_size: int = 8,
-                 initial_routes=None):
+                 initial_routes=None, bidirectional: bool = True):
+        self.bidirectional = bidirectional
         self.inst = instance
         self.t0 = time.perf_counter()
         limit = float(time_limit) if time_limit is not None else math.inf
@@ -160,7 +161,8 @@ class BranchAndPrice:
         t = time.perf_counter()
         res = price(cost, ret, prof, self.budget, self.ng, allowed, heuristic=heuristic,
                     max_labels=200_000 if heuristic else 2_000_000, n_cols=30 if heuristic else 60,
-                    min_gain=y0 + TOL, deadline=self.deadline)
+                    min_gain=y0 + TOL, deadline=self.deadline,
+                    bidirectional=self.bidirectional and not heuristic)
         self.stats.pricing_s += time.perf_counter() - t
         self.stats.labels += res.n_labels
         return res
@@ -196,6 +198,8 @@ class BranchAndPrice:
                 bound = min(bound, m.lagrangian_bound(y, res.best))
                 if state.depth == 0:
                     self._log(bound)
+                elif self._prunable(bound):
+                    return bound, x, xa, True  # pruned before the LP converged
             if res.routes and m.add_routes(res.routes):
                 continue
             if res.best - y0 > TOL and res.cycles:
@@ -273,7 +277,7 @@ class BranchAndPrice:
             for ch in children:
                 heapq.heappush(heap, (-bound, -ch.depth, counter, ch))
                 counter += 1
-            if self.stats.nodes % 25 == 0 and self.master.n_routes > last_milp_cols:
+            if self.stats.nodes % 10 == 0 and self.master.n_routes > last_milp_cols:
                 self._run_milp(min(5.0, 0.1 * max(self._time_left(), 0.0)))
                 last_milp_cols = self.master.n_routes
         else:
@@ -291,7 +295,7 @@ class BranchAndPrice:
 
 
 def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
-             initial_routes=None, ng_size: int = 8) -> Result:
+             initial_routes=None, ng_size: int = 8, bidirectional: bool = True) -> Result:
     """Branch-and-price: proven optimum, or the best plan and a certified bound at the limit.
 
     ``initial_routes`` (node ids, e.g. a heuristic plan's routes) are added as starting columns
@@ -302,7 +306,7 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
     if reason is not None:
         return Result("bp", Status.INFEASIBLE, reason=reason, runtime_s=time.perf_counter() - t0)
     bp = BranchAndPrice(instance, time_limit=time_limit, ng_size=ng_size,
-                        initial_routes=initial_routes)
+                        initial_routes=initial_routes, bidirectional=bidirectional)
     proven, bound = bp.run()
     st = bp.stats
     info = {

@@ -45,6 +45,8 @@ def _completion(mask, room, order, profit, cin):
     further node w (not remembered in ``mask``) costs at least ``cin[w]``; ``order`` lists the
     positive-prize nodes by prize/cin, best first."""
     ub = 0.0
+    if room <= 0.0:
+        return 0.0
     for w in order:
         if mask[w >> 6] & (np.uint64(1) << np.uint64(w & 63)):
             continue
@@ -61,10 +63,12 @@ def _completion(mask, room, order, profit, cin):
 
 @njit(cache=True)
 def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, threshold,
-           deadline):
-    """Labelling from node 0 to node n-1. Returns (count, node, pred, energy, prize, hit_cap).
+           deadline, last_leg, half):
+    """Labelling from node 0 to node n-1.
 
-    Labels whose prize plus the completion bound cannot exceed ``threshold`` are not stored.
+    Returns (count, node, pred, energy, prize, mask, alive, hit_cap, threshold). Labels whose
+    prize plus the completion bound cannot exceed ``threshold`` are not stored; only labels with
+    energy <= ``half`` are extended (``half`` = budget for a one-way search).
     """
     n = cost.shape[0]
     end = n - 1
@@ -94,6 +98,13 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             qi += 1
             continue
         v = node[qi]
+        if en[qi] > half:
+            qi += 1
+            continue
+        # the threshold may have risen since this label was stored
+        if pr[qi] + _completion(mask[qi], budget - en[qi] - last_leg, order, profit, cin) <= threshold:
+            qi += 1
+            continue
         for w in range(1, end):
             if not allowed[w]:
                 continue
@@ -109,12 +120,20 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             for k in range(W):
                 newmask[k] = mask[qi, k] & ng[w, k]
             newmask[wd] |= wb
-            if p2 + _completion(newmask, budget - e2, order, profit, cin) <= threshold:
+            if p2 + _completion(newmask, budget - e2 - last_leg, order, profit, cin) <= threshold:
                 continue
             # dominance against the labels at w
             dominated = False
             j = head[w]
+            prev = -1
             while j >= 0:
+                if not alive[j]:  # unlink labels dominated earlier
+                    j = nxt[j]
+                    if prev < 0:
+                        head[w] = j
+                    else:
+                        nxt[prev] = j
+                    continue
                 if alive[j]:
                     if en[j] <= e2 + EPS and pr[j] >= p2 - EPS:
                         sub = True
@@ -135,6 +154,7 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
                                     break
                         if sub:
                             alive[j] = False
+                prev = j
                 j = nxt[j]
             if dominated:
                 continue
@@ -171,7 +191,55 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
         if hit:
             break
         qi += 1
-    return count, node[:count], pred[:count], en[:count], pr[:count], hit
+    return (count, node[:count], pred[:count], en[:count], pr[:count], mask[:count],
+            alive[:count], hit, threshold)
+
+
+@njit(cache=True)
+def _join(fnode, fen, fpr, fmask, falive, bnode, ben, bpr, bmask, bstart, border, cost, budget,
+          half, threshold, max_pairs):
+    """Join forward labels (energy <= half) with backward labels through one arc.
+
+    Backward labels of point u are ``border[bstart[u]:bstart[u+1]]`` sorted by prize, best
+    first (the end's own root label included). Returns the pairs worth more than the (rising)
+    threshold and the final threshold.
+    """
+    n = cost.shape[0]
+    W = fmask.shape[1]
+    pf = np.empty(max_pairs, np.int64)
+    pb = np.empty(max_pairs, np.int64)
+    val = np.empty(max_pairs, np.float64)
+    k = 0
+    for f in range(fnode.shape[0]):
+        if not falive[f] or fen[f] > half:
+            continue
+        v = fnode[f]
+        for u in range(1, n):
+            if u == v:
+                continue
+            room = budget - fen[f] - cost[v, u]
+            if not room >= 0.0:
+                continue
+            for t in range(bstart[u], bstart[u + 1]):
+                b = border[t]
+                if fpr[f] + bpr[b] <= threshold:
+                    break
+                if ben[b] > room:
+                    continue
+                ok = True
+                for q in range(W):
+                    if fmask[f, q] & bmask[b, q]:
+                        ok = False
+                        break
+                if not ok:
+                    continue
+                if k < max_pairs:
+                    pf[k] = f
+                    pb[k] = b
+                    val[k] = fpr[f] + bpr[b]
+                    k += 1
+                threshold = fpr[f] + bpr[b]
+    return pf[:k], pb[:k], val[:k], threshold
 
 
 def n_words(n_points: int) -> int:
@@ -229,15 +297,8 @@ class PricingResult:
         self.n_labels = n_labels
 
 
-def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_cols, min_gain,
-          deadline=np.inf):
-    """Run the labelling; return a :class:`PricingResult`.
-
-    ``profit`` holds the reduced prize of every point (0 at start and end); the value reported is
-    the best path prize (the caller subtracts the vehicle dual). ``routes`` are up to ``n_cols``
-    elementary paths with prize > ``min_gain``, best first; ``cycles`` lists, for the best
-    non-elementary ng-paths, their repeated segments (to grow the ng sets).
-    """
+def _prepare(cost, ret, profit, allowed):
+    """Completion-bound data: order of positive nodes by prize/cin, cin, and the last-leg energy."""
     n = cost.shape[0]
     end = n - 1
     pts = np.arange(n)
@@ -245,28 +306,92 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     src = inner | (pts == 0)
     cin = np.where(src[:, None], cost, np.inf)
     np.fill_diagonal(cin, np.inf)
-    cin = cin.min(axis=0)
+    cin = cin.min(axis=0).astype(np.float64)
     good = np.flatnonzero(inner & (profit > 0))
     ratio = np.where(cin[good] > 0, profit[good] / np.maximum(cin[good], 1e-300), np.inf)
     order = good[np.argsort(-ratio, kind="stable")].astype(np.int64)
-    count, node, pred, en, pr, hit = _label(
-        cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin.astype(np.float64),
-        float(min_gain), float(deadline),
+    # Any further node is followed, eventually, by one arc into the end that no cin[] counts.
+    last_leg = float(cost[inner, end].min()) if inner.any() else 0.0
+    last_leg = min(max(last_leg, 0.0), float(ret[inner].min()) if inner.any() else 0.0)
+    return order, cin, last_leg
+
+
+def _chain(node, pred, j):
+    """Points of a label's path, from the root's successor to the label's point."""
+    path = []
+    while j > 0:
+        path.append(int(node[j]))
+        j = int(pred[j])
+    path.reverse()
+    return path
+
+
+def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_cols, min_gain,
+          deadline=np.inf, bidirectional=False):
+    """Run the labelling; return a :class:`PricingResult`.
+
+    ``profit`` holds the reduced prize of every point (0 at start and end); the value reported is
+    the best path prize (the caller subtracts the vehicle dual). ``routes`` are up to ``n_cols``
+    elementary paths with prize > ``min_gain``, best first; ``cycles`` lists, for the best
+    non-elementary ng-paths, their repeated segments (to grow the ng sets).
+
+    Bidirectional search: forward labels from the start and backward labels from the end (the
+    same labelling on the reversed graph) are extended only while their energy is <= budget/2,
+    then joined through one arc. Every path splits at its last arc leaving a forward prefix of
+    energy <= budget/2; its suffix then has energy < budget/2, so both halves (or labels that
+    dominate them) exist and their join is examined.
+    """
+    n = cost.shape[0]
+    end = n - 1
+    half = budget / 2.0 if bidirectional else budget
+    order, cin, last_leg = _prepare(cost, ret, profit, allowed)
+    count, node, pred, en, pr, fmask, falive, hit, thr = _label(
+        cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin,
+        float(min_gain), float(deadline), last_leg, half,
     )
+    total = int(count)
+    found = []  # (value, path)
     ok = (node > 0) & (en + cost[node, end] <= budget)
+    cand = np.flatnonzero(ok & (pr > min_gain))
+    for li in cand[np.argsort(-pr[cand], kind="stable")][: 4 * n_cols]:
+        found.append((float(pr[li]), _chain(node, pred, int(li))))
     best = float(pr[ok].max()) if ok.any() else 0.0
+    if bidirectional and not hit:
+        perm = np.concatenate([[end], np.arange(1, end), [0]])
+        cost_b = np.ascontiguousarray(cost.T[np.ix_(perm, perm)])
+        ret_b = cheapest_return(cost_b)
+        allowed_b = allowed[perm]
+        profit_b = np.ascontiguousarray(profit[perm])
+        order_b, cin_b, last_b = _prepare(cost_b, ret_b, profit_b, allowed_b)
+        bcount, bnode, bpred, ben, bpr, bmask, balive, bhit, thr = _label(
+            cost_b, ret_b, profit_b, budget, ng, allowed_b, heuristic, max_labels, order_b, cin_b,
+            float(thr), float(deadline), last_b, half,
+        )
+        total += int(bcount)
+        hit = hit or bhit
+        bok = (bnode > 0) & (ben + cost_b[bnode, end] <= budget)
+        if bok.any():
+            best = max(best, float(bpr[bok].max()))
+        cand = np.flatnonzero(bok & (bpr > min_gain))
+        for li in cand[np.argsort(-bpr[cand], kind="stable")][: 2 * n_cols]:
+            found.append((float(bpr[li]), _chain(bnode, bpred, int(li))[::-1]))
+        # backward labels grouped by original point (the root, point 0 here, is the end)
+        point = np.where(bnode == 0, end, bnode)
+        keep = np.flatnonzero(balive)
+        keep = keep[np.lexsort((-bpr[keep], point[keep]))]
+        bstart = np.searchsorted(point[keep], np.arange(n + 1)).astype(np.int64)
+        pf, pb, val, thr = _join(node, en, pr, fmask, falive, bnode, ben, bpr, bmask, bstart,
+                                 keep.astype(np.int64), cost, budget, half, float(thr), 4 * n_cols)
+        if val.size:
+            best = max(best, float(val.max()))
+        for f, b, v in zip(pf, pb, val):
+            if v > min_gain:
+                found.append((float(v), _chain(node, pred, int(f)) + _chain(bnode, bpred, int(b))[::-1]))
     # Paths pruned by the completion bound are worth at most min_gain; the empty route is 0.
     best = max(best, 0.0, float(min_gain))
-    cand = np.flatnonzero(ok & (pr > min_gain))
-    cand = cand[np.argsort(-pr[cand], kind="stable")]
+    found.sort(key=lambda t: -t[0])
     routes, cycles, seen = [], [], set()
-    for li in cand:
-        path = []
-        j = int(li)
-        while j > 0:
-            path.append(int(node[j]))
-            j = int(pred[j])
-        path.reverse()
+    for _, path in found:
         if len(set(path)) == len(path):
             key = tuple(path)
             if key not in seen:
@@ -280,4 +405,4 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
                 if u in last:
                     cycles.append(tuple(path[last[u] : pos + 1]))
                 last[u] = pos
-    return PricingResult(best, (not hit) and (not heuristic), routes, cycles, int(count))
+    return PricingResult(best, (not hit) and (not heuristic), routes, cycles, total)
