@@ -143,3 +143,27 @@ def test_top_sets_1_to_3_all(name):
     assert res.bound is None or res.bound >= OPTIMAL[name] - 1e-6
     assert res.status == Status.OPTIMAL, res.reason
     assert res.objective == OPTIMAL[name]
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_small_sar_matches_brute_force(seed):
+    """SAR form (unit prizes, one group per target) with a binding budget: optimum equals enumeration."""
+    from formulations.generate import generate
+    from formulations.instance import to_top
+
+    inst = to_top(generate(3, 2, 1, seed, e_max=5500.0))
+    best = brute_force(inst)
+    assert best is not None and best < inst.total_prize  # feasible, and the budget binds
+    res, rep = run_method("bp", inst, time_limit=30)
+    assert res.status == Status.OPTIMAL and res.objective == best
+
+
+def test_sar_infeasible_when_targets_do_not_fit():
+    """Every target reachable alone but not all in one flight: proven infeasible (precheck passes)."""
+    from formulations.generate import generate
+    from formulations.instance import precheck, to_top
+
+    inst = to_top(generate(3, 2, 1, 0, e_max=4800.0))
+    assert precheck(inst) is None and brute_force(inst) is None
+    res, rep = run_method("bp", inst, time_limit=30)
+    assert res.status == Status.INFEASIBLE
