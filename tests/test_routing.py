@@ -145,3 +145,25 @@ def test_top_never_beats_optimum(method, name):
     assert res.status == Status.FEASIBLE
     assert res.objective <= _optima()[name] + 1e-9
     assert res.objective >= 0.9 * _optima()[name]
+
+
+def test_routing_reproducible_when_stopped_by_solution_limit():
+    """OR-Tools routing stopped by its solution limit (not time) returns the same plan twice."""
+    from formulations.routing import solve_routing
+
+    inst = load_instance(TOP_DIR / "p2.3.g.txt")
+    a = solve_routing(inst, time_limit=30.0, solution_limit=200)
+    b = solve_routing(inst, time_limit=30.0, solution_limit=200)
+    assert a.info["stopped_by"] == "solution_limit"
+    assert a.plan == b.plan
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method", PEERS)
+def test_top_all_files_never_beat_optimum(method):
+    """All 117 TOP files (2 s each): every plan verifies and none exceeds the published optimum."""
+    optima = _optima()
+    for name, value in optima.items():
+        res, rep = run_method(method, load_instance(TOP_DIR / f"{name}.txt"), time_limit=2.0)
+        assert res.status == Status.FEASIBLE, f"{name}: {res.reason}"
+        assert res.objective <= value + 1e-9, f"{name}: {res.objective} > optimum {value}"
