@@ -38,7 +38,8 @@ def sized_instances(size: int, count: int = 3, n_uavs: int = 2) -> list[TOPInsta
     """``count`` SAR instances (K = 3, N = 2) whose budget leaves exactly ``size`` viewpoints reachable.
 
     E_max is the ``size``-th smallest viewpoint round trip (plus 1e-6 relative), kept only when it
-    also covers every target (at least the coverage threshold): a tight budget by construction.
+    also covers every target (at least the coverage threshold) and greedy finds a plan, so the
+    case is feasible: a tight budget by construction.
     """
     found, seed = [], 0
     while len(found) < count and seed < 300:
@@ -49,8 +50,8 @@ def sized_instances(size: int, count: int = 3, n_uavs: int = 2) -> list[TOPInsta
             e_max = float(trip[size - 1]) * (1 + 1e-6)
             if e_max >= thr and (size == len(trip) or trip[size] > e_max) and len(found) < count:
                 inst = to_top(generate(m, 3, n_uavs, seed, e_max=e_max))
-                if int(inst.reachable().sum()) == size:
-                    found.append(inst)
+                if int(inst.reachable().sum()) == size and greedy(inst).plan is not None:
+                    found.append(inst)  # feasible (greedy covers every target): an optimisation case
         seed += 1
     return found
 
