@@ -18,6 +18,7 @@ import os
 import statistics
 import time
 
+import highspy
 import numpy as np
 
 from formulations.cpsat import solve_cpsat
@@ -42,7 +43,7 @@ def sized_instances(size: int, count: int = 3, n_uavs: int = 2) -> list[TOPInsta
     case is feasible: a tight budget by construction.
     """
     found, seed = [], 0
-    while len(found) < count and seed < 300:
+    while len(found) < count and seed < 600:
         for m in range(-(-size // 3), -(-size // 3) + 3):
             base = to_top(generate(m, 3, n_uavs, seed))
             trip = np.sort(base.round_trip_cost())
@@ -62,6 +63,9 @@ def solve(method: str, inst: TOPInstance, threads: int, time_limit: float = TIME
         warm = None
     if method == "cpsat":
         return solve_cpsat(inst, time_limit=time_limit, threads=threads, hint=warm)
+    # HiGHS keeps one global thread pool per process; a run with another thread count fails
+    # ("HiGHS stopped: unknown") unless the pool is reset first.
+    highspy.Highs.resetGlobalScheduler(True)
     return solve_milp(inst, time_limit=time_limit, threads=threads, warm_start=warm)
 
 
