@@ -2,7 +2,8 @@
 
 - :func:`run_one` runs one job (build the instance, :func:`benchmarks.registry.run_method`, which
   verifies the plan) and returns its results row. It never raises.
-- Local execution keeps ``workers`` long-lived processes, each running one job at a time. The
+- Local execution keeps ``workers`` long-lived processes, each running one job at a time (short
+  jobs are sent in batches, see :func:`_next_batch`, each still with its own deadline and row). The
   parent watches every job's deadline (``time_limit + grace``): a job past it is SIGKILLed with its
   worker and recorded as ``time_limit``; a worker that dies (segfault, out of memory, ``os._exit``)
   is recorded as ``error``; a fresh worker takes its place and the suite goes on. ``memory_mb``
@@ -300,11 +301,12 @@ def _worker_main(conn, memory_mb: int, parent_pid: int) -> None:
             return
         if job is None:
             return
-        row = run_one(job)
-        try:
-            conn.send(row)
-        except (BrokenPipeError, OSError):
-            return
+        for one in (job if isinstance(job, list) else [job]):  # a batch: one row back per job
+            row = run_one(one)
+            try:
+                conn.send(row)
+            except (BrokenPipeError, OSError):
+                return
 
 
 class _Worker:
@@ -313,15 +315,23 @@ class _Worker:
         self.proc = ctx.Process(target=_worker_main, args=(child, memory_mb, os.getpid()), daemon=True)
         self.proc.start()
         child.close()
-        self.job: dict | None = None
+        self.job: dict | None = None  # the job running now (the head of ``queue``)
+        self.queue: deque = deque()  # this worker's batch, in order; rows come back one by one
         self.started = 0.0
 
-    def assign(self, job: dict) -> None:
-        self.job, self.started = job, time.monotonic()
+    def assign(self, jobs: list[dict]) -> None:
+        self.queue = deque(jobs)
+        self.job, self.started = jobs[0], time.monotonic()
         try:
-            self.conn.send(job)
+            self.conn.send(jobs)
         except OSError:  # the worker died idle; the main loop records and replaces it
             pass
+
+    def done_one(self) -> None:
+        """The head job's row arrived: the next job of the batch starts its clock now."""
+        self.queue.popleft()
+        self.job = self.queue[0] if self.queue else None
+        self.started = time.monotonic()
 
     def kill(self) -> None:
         if self.proc.is_alive():
@@ -346,6 +356,29 @@ def _exit_reason(code: int | None) -> str:
     return f"worker process exited with code {code}"
 
 
+BATCH_TIME_LIMIT = 10.0  # jobs with at most this time limit may share one worker task
+MAX_BATCH = 32
+
+
+def _next_batch(pending: deque, workers: int) -> list[dict]:
+    """The next task for an idle worker: one job, or several short ones in a row.
+
+    Cheap heuristic jobs take milliseconds; sending them one at a time costs a pipe round trip and
+    leaves the worker idle while the parent writes the row. Consecutive jobs with a time limit of
+    at most ``BATCH_TIME_LIMIT`` go as one batch of at most ``MAX_BATCH`` jobs (and at most a
+    quarter of what is left per worker, so the tail stays balanced). Each job keeps its own
+    deadline and its own row, sent back as it finishes.
+    """
+    first = pending.popleft()
+    batch = [first]
+    if first["time_limit"] > BATCH_TIME_LIMIT:
+        return batch
+    size = min(MAX_BATCH, max(1, len(pending) // (4 * workers)))
+    while len(batch) < size and pending and pending[0]["time_limit"] <= BATCH_TIME_LIMIT:
+        batch.append(pending.popleft())
+    return batch
+
+
 def run_local(jobs: list[dict], emit, *, workers: int, memory_mb: int = 0) -> None:
     """Run ``jobs`` on ``workers`` processes, calling ``emit(row)`` in the parent as each ends."""
     if not jobs:
@@ -357,7 +390,7 @@ def run_local(jobs: list[dict], emit, *, workers: int, memory_mb: int = 0) -> No
         while pending or any(w.job is not None for w in pool):
             for w in pool:
                 if w.job is None and pending:
-                    w.assign(pending.popleft())
+                    w.assign(_next_batch(pending, len(pool)))
             busy = [w for w in pool if w.job is not None]
             now = time.monotonic()
             timeout = min((w.started + w.job["time_limit"] + w.job["grace"] - now for w in busy), default=1.0)
@@ -365,17 +398,18 @@ def run_local(jobs: list[dict], emit, *, workers: int, memory_mb: int = 0) -> No
             for i, w in enumerate(pool):
                 if w.job is None:
                     continue
-                elapsed = time.monotonic() - w.started
                 dead = False
-                if w.conn.poll():
+                while w.job is not None and w.conn.poll():  # drain every row the batch has sent
                     try:
                         row = w.conn.recv()
                     except (EOFError, OSError):
                         dead = True
-                    else:
-                        w.job = None
-                        emit(row)
-                        continue
+                        break
+                    w.done_one()
+                    emit(row)
+                if w.job is None:
+                    continue
+                elapsed = time.monotonic() - w.started
                 if dead or not w.proc.is_alive():
                     w.proc.join(1)
                     emit(failed_row(w.job, "error", _exit_reason(w.proc.exitcode), elapsed))
@@ -385,6 +419,8 @@ def run_local(jobs: list[dict], emit, *, workers: int, memory_mb: int = 0) -> No
                                     f"+ grace {w.job['grace']:g} s)", elapsed))
                 else:
                     continue
+                w.queue.popleft()
+                pending.extendleft(reversed(w.queue))  # the rest of its batch goes back in line
                 w.kill()
                 pool[i] = _Worker(ctx, memory_mb)
     finally:

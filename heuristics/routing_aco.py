@@ -13,7 +13,8 @@ which then deposits as the elitist ant (without it the ant system found the opti
 Vectorised over ants and clusters at once: the colony is (B, P) ants, a step draws every ant's
 next viewpoint by a roulette wheel (a cumulative sum over the candidates and one uniform draw per
 ant), and deposits use one ``np.bincount``. The only Python loop
-is over the L construction steps.
+is over the L construction steps; with numba (default when importable) those steps run in the
+compiled :func:`heuristics.kernels.construct_tours` on the same draws (same tours, ~10x fewer calls).
 """
 
 from __future__ import annotations
@@ -22,7 +23,11 @@ import time
 
 import numpy as np
 
+from heuristics.kernels import HAVE_NUMBA
 from heuristics.tour import ClusterBatch, best_two_opt_moves, invert
+
+if HAVE_NUMBA:
+    from heuristics.kernels import construct_tours
 
 _PAD = -1e300
 # Weight of a pad: absorbed in the wheel's total (≥ 1e-20 while real viewpoints remain, since
@@ -47,7 +52,9 @@ class ACORouter:
         rho: float = 0.5,
         elitist: float = 5.0,
         local_search: bool = True,
+        use_numba: bool | None = None,
     ):
+        self.use_numba = HAVE_NUMBA if use_numba is None else bool(use_numba and HAVE_NUMBA)
         self.n_ants = n_ants
         self.n_iterations = n_iterations
         self.alpha, self.beta, self.rho, self.elitist = alpha, beta, rho, elitist
@@ -78,19 +85,22 @@ class ACORouter:
             weight = np.maximum(np.exp(logw - logw.max(axis=-1, keepdims=True)), _MIN_WEIGHT)
             weight[pad3] = _PAD_WEIGHT
             weight = weight.astype(np.float32).reshape(B * (L + 1), L)
-            avail = np.ones(B * P * L, dtype=np.float32)
-            cur = np.full((B, P), L) + row_state
-            tours = np.empty((L, B, P), dtype=int)
             u = rng.random((L, B, P), dtype=np.float32) * np.float32(1.0 - 1e-6)  # r < total
-            for s in range(L - 1):
-                w = np.take(weight, cur, axis=0)
-                w *= avail.reshape(B, P, L)
-                np.cumsum(w, axis=-1, out=w)  # roulette wheel over the unvisited
-                nxt = np.argmax(w > (u[s] * w[..., -1])[..., None], axis=-1)
-                tours[s] = nxt
-                avail[ant_base + nxt] = 0.0
-                cur = row_state + nxt
-            tours[L - 1] = np.argmax(avail.reshape(B, P, L), axis=-1)  # the one left
+            if self.use_numba:  # same wheel, same draws, compiled (heuristics.kernels)
+                tours = construct_tours(weight, u, B, P, L)
+            else:
+                avail = np.ones(B * P * L, dtype=np.float32)
+                cur = np.full((B, P), L) + row_state
+                tours = np.empty((L, B, P), dtype=int)
+                for s in range(L - 1):
+                    w = np.take(weight, cur, axis=0)
+                    w *= avail.reshape(B, P, L)
+                    np.cumsum(w, axis=-1, out=w)  # roulette wheel over the unvisited
+                    nxt = np.argmax(w > (u[s] * w[..., -1])[..., None], axis=-1)
+                    tours[s] = nxt
+                    avail[ant_base + nxt] = 0.0
+                    cur = row_state + nxt
+                tours[L - 1] = np.argmax(avail.reshape(B, P, L), axis=-1)  # the one left
             tours = tours.transpose(1, 2, 0)
             f = batch.lengths(D, tours)
             k = np.argmin(f, axis=1)

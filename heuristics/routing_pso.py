@@ -16,6 +16,9 @@ tour in about 1 run of 2 with any of w ∈ {0.5, 0.73, 0.9}, c ∈ {1, 1.5, 2}, 
 so by default (``local_search=True``) each iteration also applies the best 2-opt move to each
 swarm's global best and writes the improved order back as keys (a memetic PSO: the swarm is
 then attracted to a 2-opt-improved leader). This costs one (B, L²/2) array per iteration.
+
+With numba (default when importable) the decoding and fitness of the whole swarm is one compiled
+call (:func:`heuristics.kernels.keyed_lengths`); the PSO update itself stays in numpy.
 """
 
 from __future__ import annotations
@@ -24,7 +27,11 @@ import time
 
 import numpy as np
 
+from heuristics.kernels import HAVE_NUMBA
 from heuristics.tour import ClusterBatch, best_two_opt_moves, invert
+
+if HAVE_NUMBA:
+    from heuristics.kernels import keyed_lengths, pso_step
 
 
 _PAD_KEY = 1e6
@@ -45,7 +52,9 @@ class PSORouter:
         c2: float = 1.49618,
         v_max: float = 1.0,
         local_search: bool = True,
+        use_numba: bool | None = None,
     ):
+        self.use_numba = HAVE_NUMBA if use_numba is None else bool(use_numba and HAVE_NUMBA)
         self.n_particles = n_particles
         self.n_iterations = n_iterations
         self.w, self.c1, self.c2, self.v_max = w, c1, c2, v_max
@@ -62,8 +71,15 @@ class PSORouter:
         v = np.where(pad, 0.0, rng.uniform(-self.v_max, self.v_max, (B, P, L)))
         rows = np.arange(B)
 
-        def evaluate(keys):
-            return batch.lengths(D, np.argsort(keys, axis=-1))
+        if self.use_numba:  # decode + lengths in one compiled call (heuristics.kernels)
+            nodes, sizes = np.ascontiguousarray(batch.nodes), np.ascontiguousarray(batch.sizes)
+            Dc = np.ascontiguousarray(D, dtype=float)
+
+            def evaluate(keys):
+                return keyed_lengths(Dc, keys, nodes, sizes, batch.start, batch.end)
+        else:
+            def evaluate(keys):
+                return batch.lengths(D, np.argsort(keys, axis=-1))
 
         f = evaluate(x)
         pbest, pbest_f = x.copy(), f
@@ -75,13 +91,11 @@ class PSORouter:
                 break
             r1 = rng.random((B, P, L))
             r2 = rng.random((B, P, L))
-            v = self.w * v + self.c1 * r1 * (pbest - x) + self.c2 * r2 * (gbest[:, None, :] - x)
-            np.clip(v, -self.v_max, self.v_max, out=v)
-            x = x + v
-            f = evaluate(x)
-            better = f < pbest_f
-            pbest = np.where(better[..., None], x, pbest)
-            pbest_f = np.where(better, f, pbest_f)
+            if self.use_numba:  # the same update, fitness and pbest in one compiled call
+                pso_step(x, v, pbest, pbest_f, gbest, r1, r2, self.w, self.c1, self.c2, self.v_max,
+                         Dc, nodes, sizes, batch.start, batch.end)
+            else:
+                x, v, pbest, pbest_f = self._move(x, v, pbest, pbest_f, gbest, r1, r2, evaluate)
             g = np.argmin(pbest_f, axis=1)
             improved = pbest_f[rows, g] < gbest_f
             gbest = np.where(improved[:, None], pbest[rows, g], gbest)
@@ -92,6 +106,17 @@ class PSORouter:
                 polished = gain <= 0
         best = np.argsort(gbest, axis=-1)
         return best, gbest_f
+
+    def _move(self, x, v, pbest, pbest_f, gbest, r1, r2, evaluate):
+        """numpy version of :func:`heuristics.kernels.pso_step`."""
+        v = self.w * v + self.c1 * r1 * (pbest - x) + self.c2 * r2 * (gbest[:, None, :] - x)
+        np.clip(v, -self.v_max, self.v_max, out=v)
+        x = x + v
+        f = evaluate(x)
+        better = f < pbest_f
+        pbest = np.where(better[..., None], x, pbest)
+        pbest_f = np.where(better, f, pbest_f)
+        return x, v, pbest, pbest_f
 
     @staticmethod
     def _improve(D, batch: ClusterBatch, gbest: np.ndarray, gbest_f: np.ndarray):
