@@ -145,13 +145,19 @@ def test_top_sets_1_to_3_all(name):
     assert res.objective == OPTIMAL[name]
 
 
-@pytest.mark.parametrize("seed", range(3))
-def test_small_sar_matches_brute_force(seed):
-    """SAR form (unit prizes, one group per target) with a binding budget: optimum equals enumeration."""
-    from formulations.generate import generate
-    from formulations.instance import to_top
+def tiny_sar(e_max: float) -> TOPInstance:
+    """Three targets, two views each, one UAV (explicit parameters: independent of the presets)."""
+    from formulations.instance import SARInstance, to_top
 
-    inst = to_top(generate(3, 2, 1, seed, e_max=5500.0))
+    targets = np.array([[1500.0, 200.0], [200.0, 1500.0], [900.0, 900.0]])
+    return to_top(SARInstance(targets=targets, n_views=2, n_uavs=1, altitude=200.0, pitch_deg=45.0,
+                              e_fly=1.0, e_image=150.0, e_max=e_max))
+
+
+@pytest.mark.parametrize("e_max", [5000.0, 5500.0, 6000.0])
+def test_small_sar_matches_brute_force(e_max):
+    """SAR form (unit prizes, one group per target) with a binding budget: optimum equals enumeration."""
+    inst = tiny_sar(e_max)
     best = brute_force(inst)
     assert best is not None and best < inst.total_prize  # feasible, and the budget binds
     res, rep = run_method("bp", inst, time_limit=30)
@@ -160,10 +166,9 @@ def test_small_sar_matches_brute_force(seed):
 
 def test_sar_infeasible_when_targets_do_not_fit():
     """Every target reachable alone but not all in one flight: proven infeasible (precheck passes)."""
-    from formulations.generate import generate
-    from formulations.instance import precheck, to_top
+    from formulations.instance import precheck
 
-    inst = to_top(generate(3, 2, 1, 0, e_max=4800.0))
+    inst = tiny_sar(4500.0)
     assert precheck(inst) is None and brute_force(inst) is None
     res, rep = run_method("bp", inst, time_limit=30)
     assert res.status == Status.INFEASIBLE

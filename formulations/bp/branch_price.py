@@ -68,12 +68,13 @@ class _Stats:
     lp_s: float = 0.0
     root_bound: float | None = None
     root_s: float | None = None
+    mode_times: tuple | None = None  # first exact pricing: (one-way s, bidirectional s)
     history: list = field(default_factory=list)  # (time, incumbent, bound)
 
 
 class BranchAndPrice:
     def __init__(self, instance: TOPInstance, *, time_limit: float | None, ng_size: int = 8,
-                 initial_routes=None, bidirectional: bool = True):
+                 initial_routes=None, bidirectional: bool | None = None):
         self.bidirectional = bidirectional
         self.inst = instance
         self.t0 = time.perf_counter()
@@ -157,15 +158,38 @@ class BranchAndPrice:
             allowed[p] = False
         return cost, cheapest_return(cost), allowed
 
-    def _price(self, cost, ret, prof, allowed, *, heuristic, y0):
+    def _price(self, cost, ret, prof, allowed, *, heuristic, y0, max_labels=None):
         t = time.perf_counter()
+        if max_labels is None:
+            max_labels = 200_000 if heuristic else 2_000_000
         res = price(cost, ret, prof, self.budget, self.ng, allowed, heuristic=heuristic,
-                    max_labels=200_000 if heuristic else 2_000_000, n_cols=30 if heuristic else 60,
+                    max_labels=max_labels, n_cols=30 if heuristic else 60,
                     min_gain=y0 + TOL, deadline=self.deadline,
-                    bidirectional=self.bidirectional and not heuristic)
+                    bidirectional=bool(self.bidirectional) and not heuristic)
         self.stats.pricing_s += time.perf_counter() - t
         self.stats.labels += res.n_labels
         return res
+
+    def _exact_price(self, cost, ret, prof, allowed, y0):
+        """Exact pricing. On the first call both searches run, the bidirectional one under the
+        one-way search's time; the faster is kept for the rest of the run (neither dominates:
+        bidirectional wins on long routes with many labels, loses when the join is large)."""
+        if self.bidirectional is not None:
+            return self._price(cost, ret, prof, allowed, heuristic=False, y0=y0)
+        t = time.perf_counter()
+        self.bidirectional = False
+        uni = self._price(cost, ret, prof, allowed, heuristic=False, y0=y0)
+        t_uni = time.perf_counter() - t
+        if not uni.exact:
+            return uni
+        saved, self.deadline = self.deadline, min(self.deadline, time.perf_counter() + 0.8 * t_uni)
+        t = time.perf_counter()
+        self.bidirectional = True
+        bi = self._price(cost, ret, prof, allowed, heuristic=False, y0=y0)
+        self.deadline = saved
+        self.stats.mode_times = (round(t_uni, 4), round(time.perf_counter() - t, 4))
+        self.bidirectional = bool(bi.exact)
+        return uni
 
     def column_generation(self, state: NodeState, bound: float):
         """Solve one node's LP by column generation. Returns (bound, x, x_art, converged)."""
@@ -192,7 +216,7 @@ class BranchAndPrice:
                 continue
             if self._time_left() <= 0:
                 return bound, x, xa, False
-            res = self._price(cost, ret, prof, allowed, heuristic=False, y0=y0)
+            res = self._exact_price(cost, ret, prof, allowed, y0)
             self.stats.exact_pricings += 1
             if res.exact:
                 bound = min(bound, m.lagrangian_bound(y, res.best))
@@ -295,11 +319,13 @@ class BranchAndPrice:
 
 
 def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
-             initial_routes=None, ng_size: int = 8, bidirectional: bool = True) -> Result:
+             initial_routes=None, ng_size: int = 8, bidirectional: bool | None = None) -> Result:
     """Branch-and-price: proven optimum, or the best plan and a certified bound at the limit.
 
     ``initial_routes`` (node ids, e.g. a heuristic plan's routes) are added as starting columns
-    and as a first incumbent. ``seed`` is unused (the method is deterministic).
+    and as a first incumbent. ``bidirectional``: exact pricing direction; None picks the faster
+    one on the first exact pricing call. ``seed`` is unused (no randomness; timing-based choices
+    and the time limit can still change the path taken).
     """
     t0 = time.perf_counter()
     reason = precheck(instance)
@@ -314,6 +340,7 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
         "exact_pricings": st.exact_pricings, "labels": st.labels, "ng_growths": st.ng_growths,
         "milp_calls": st.milp_calls, "pricing_s": round(st.pricing_s, 3), "lp_s": round(st.lp_s, 3),
         "root_bound": st.root_bound, "root_s": st.root_s, "history": st.history, "threads": 1,
+        "bidirectional": bp.bidirectional, "mode_times": st.mode_times,
     }
     runtime = time.perf_counter() - t0
     plan = None if bp.incumbent is None else Plan.of([[p - 1 for p in r] for r in bp.incumbent])
