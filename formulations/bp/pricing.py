@@ -406,3 +406,21 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
                     cycles.append(tuple(path[last[u] : pos + 1]))
                 last[u] = pos
     return PricingResult(best, (not hit) and (not heuristic), routes, cycles, total)
+
+
+_WARM = False
+
+
+def warm_up() -> None:
+    """Compile (or load from numba's on-disk cache) the labelling routines once per process."""
+    global _WARM
+    if _WARM:
+        return
+    cost = np.array([[0.0, 1.0, 2.0], [1.0, 0.0, 1.0], [2.0, 1.0, 0.0]])
+    ret = cheapest_return(cost)
+    prof = np.array([0.0, 1.0, 0.0])
+    for bi in (False, True):
+        for heur in (False, True):
+            price(cost, ret, prof, 4.0, full_ng(3), np.ones(3, dtype=bool), heuristic=heur,
+                  max_labels=100, n_cols=1, min_gain=0.5, bidirectional=bi)
+    _WARM = True
