@@ -188,8 +188,9 @@ class BranchAndPrice:
         self.bidirectional = True
         bi = self._price(cost, ret, prof, allowed, heuristic=False, y0=y0)
         self.deadline = saved
-        self.stats.mode_times = (round(t_uni, 4), round(time.perf_counter() - t, 4))
-        self.bidirectional = bool(bi.exact)
+        t_bi = time.perf_counter() - t
+        self.stats.mode_times = (round(t_uni, 4), round(t_bi, 4))
+        self.bidirectional = bool(bi.exact) and t_bi < 0.8 * t_uni
         return uni
 
     def column_generation(self, state: NodeState, bound: float):
