@@ -8,7 +8,8 @@ labelling pricing (:mod:`.pricing`):
    the certified Lagrangian bound of the round; improving elementary routes become columns; if
    only non-elementary ng-paths improve, the ng sets grow along their cycles and pricing repeats
    (decremental state space relaxation). The node is solved when exact pricing finds nothing
-   above the vehicle dual.
+   above the vehicle dual. One-way or bidirectional exact labelling, whichever the first exact
+   call measures faster.
 
 Branching, in order: on a fractional node visit (forbid the node / force it visited: a forced node
 row becomes ``= 1``); then, when all visits are integral, on a fractional arc flow (forbid the arc

@@ -17,6 +17,19 @@ One compiled routine (numba) serves three uses, chosen by its arguments:
 * **heuristic** (``heuristic=True``): dominance ignores the visited sets (paths stay elementary),
   so there are few labels per node; fast, finds improving columns, proves nothing.
 
+Pruning: a label whose prize plus a fractional-knapsack completion bound (each further node w
+costs at least its cheapest incoming arc, plus one last arc into the end) cannot exceed the
+threshold is dropped. The threshold starts at the vehicle dual (a route must beat it to have a
+positive reduced prize) and, in exact mode, rises to the best complete path found so far. The
+value reported is max(best path found, starting threshold): an upper bound on the best
+*elementary* path (an elementary path's suffix visits distinct nodes that are not in the
+remembered set of any label dominating its prefix, so the once-per-node knapsack bounds it),
+which is all the master's bound needs.
+
+Bidirectional mode (exact only): the same routine runs forward from the start and backward from
+the end (on the reversed graph), extending labels only up to half the budget, and the halves are
+joined through one arc (see :func:`price`). The branch-and-price picks the direction by timing.
+
 A label is only created if the end is still reachable within the budget (``ret`` = cheapest
 energy to the end in the allowed graph), so every stored label is a complete route candidate:
 its route is its path followed by the end. Sets are bitsets of ``W`` 64-bit words.
