@@ -65,6 +65,21 @@ def environment() -> dict:
     return _ENV
 
 
+_LAST_INSTANCE: tuple[str, object] | None = None
+
+
+def cached_instance(source: dict):
+    """:func:`build_instance`, reusing the previous job's instance when the source is the same
+    (a suite lists each instance's methods in a row, and a batch runs them in one process)."""
+    global _LAST_INSTANCE
+    key = json.dumps({k: v for k, v in source.items() if k not in ("exact",)}, sort_keys=True, default=str)
+    if _LAST_INSTANCE is not None and _LAST_INSTANCE[0] == key:
+        return _LAST_INSTANCE[1]
+    instance = build_instance(source)
+    _LAST_INSTANCE = (key, instance)
+    return instance
+
+
 def build_instance(source: dict):
     """The TOPInstance a job's ``source`` describes (generator parameters or a file)."""
     if source["type"] == "generate":
@@ -116,7 +131,7 @@ def run_one(job: dict) -> dict:
     try:
         from benchmarks.registry import result_record, run_method
 
-        instance = build_instance(job["source"])
+        instance = cached_instance(job["source"])
         row.update(kind=instance.kind, n_nodes=instance.n_nodes, n_groups=len(instance.groups),
                    n_vehicles=instance.n_vehicles, e_max=instance.budget)
         ensure_method(job["method"])
