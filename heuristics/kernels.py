@@ -108,3 +108,47 @@ if HAVE_NUMBA:
                     for i in range(L):
                         pbest[b, p, i] = x[b, p, i]
         return f
+
+    @njit(cache=True, nogil=True)
+    def ga_children(pop, win, lo1, hi1, cross, lo2, hi2, mutate):  # pragma: no cover - compiled
+        """The GA's children (B, C, L): parents pop[b, win[b, c]] and pop[b, win[b, C + c]], order
+        crossover keeping parent 1's slice lo1..hi1 where ``cross``, then the inversion of
+        lo2..hi2 where ``mutate`` (flat child index b*C + c), exactly as the numpy version."""
+        B, P, L = pop.shape
+        C = win.shape[1] // 2
+        child = np.empty((B, C, L), dtype=pop.dtype)
+        member = np.zeros(L, dtype=np.bool_)
+        tmp = np.empty(L, dtype=pop.dtype)
+        for b in range(B):
+            for c in range(C):
+                k = b * C + c
+                p1 = pop[b, win[b, c]]
+                if cross[k]:
+                    p2 = pop[b, win[b, C + c]]
+                    lo, hi = lo1[k], hi1[k]
+                    member[:] = False
+                    for i in range(lo, hi + 1):
+                        member[p1[i]] = True
+                    j = 0
+                    for i in range(L):
+                        if lo <= i <= hi:
+                            tmp[i] = p1[i]
+                        else:
+                            while member[p2[j]]:
+                                j += 1
+                            tmp[i] = p2[j]
+                            j += 1
+                else:
+                    for i in range(L):
+                        tmp[i] = p1[i]
+                if mutate[k]:
+                    lo, hi = lo2[k], hi2[k]
+                    for i in range(L):
+                        if lo <= i <= hi:
+                            child[b, c, i] = tmp[lo + hi - i]
+                        else:
+                            child[b, c, i] = tmp[i]
+                else:
+                    for i in range(L):
+                        child[b, c, i] = tmp[i]
+        return child

@@ -10,6 +10,8 @@ positions left to right with the missing viewpoints in parent 2's order) with pr
 Like the PSO, all clusters run in one (B, P, L) batch: a row's pads sit in the tail positions of
 every individual and stay there (cuts and inversions are drawn inside the real positions), so
 no per-individual Python loop is needed; OX is done for the whole batch with two scatters.
+With numba (default when importable) crossover and mutation of all children run in the compiled
+:func:`heuristics.kernels.ga_children` on the same draws (same children); fitness stays in numpy.
 """
 
 from __future__ import annotations
@@ -18,7 +20,11 @@ import time
 
 import numpy as np
 
+from heuristics.kernels import HAVE_NUMBA
 from heuristics.tour import ClusterBatch, invert
+
+if HAVE_NUMBA:
+    from heuristics.kernels import ga_children
 
 
 def order_crossover(p1: np.ndarray, p2: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -53,7 +59,9 @@ class GARouter:
         p_crossover: float = 0.9,
         p_mutation: float = 0.3,
         n_elite: int = 2,
+        use_numba: bool | None = None,
     ):
+        self.use_numba = HAVE_NUMBA if use_numba is None else bool(use_numba and HAVE_NUMBA)
         self.n_population = n_population
         self.n_iterations = n_iterations
         self.p_crossover = p_crossover
@@ -78,15 +86,18 @@ class GARouter:
             elite_f = f[rows, rank[:, :E]]
             t = rng.integers(0, P, size=(B, 2 * C, 2))  # binary tournaments
             win = np.where(f[rows, t[..., 0]] <= f[rows, t[..., 1]], t[..., 0], t[..., 1])
-            p1 = pop[rows, win[:, :C]].reshape(B * C, L)
-            p2 = pop[rows, win[:, C:]].reshape(B * C, L)
-            lo, hi = _cuts(rng, sizes)
+            lo1, hi1 = _cuts(rng, sizes)
             cross = rng.random(B * C) < self.p_crossover
-            child = np.where(cross[:, None], order_crossover(p1, p2, lo, hi), p1)
-            lo, hi = _cuts(rng, sizes)
+            lo2, hi2 = _cuts(rng, sizes)
             mutate = rng.random(B * C) < self.p_mutation
-            child = invert(child, np.where(mutate, lo, 1), np.where(mutate, hi, 0))
-            child = child.reshape(B, C, L)
+            if self.use_numba:  # same children from the same draws, compiled (heuristics.kernels)
+                child = ga_children(pop, win, lo1, hi1, cross, lo2, hi2, mutate)
+            else:
+                p1 = pop[rows, win[:, :C]].reshape(B * C, L)
+                p2 = pop[rows, win[:, C:]].reshape(B * C, L)
+                child = np.where(cross[:, None], order_crossover(p1, p2, lo1, hi1), p1)
+                child = invert(child, np.where(mutate, lo2, 1), np.where(mutate, hi2, 0))
+                child = child.reshape(B, C, L)
             pop = np.concatenate([elite, child], axis=1)
             f = np.concatenate([elite_f, batch.lengths(D, child)], axis=1)
         best = np.argmin(f, axis=1)
