@@ -11,6 +11,7 @@ paper-peers    routing (2 s) and pyvrp (1 s) on the first 20 instances of every 
 exact-small    every method on 8-40 viewpoints; milp, cpsat, bp (60 s) prove optima -> gaps
 paper-gaps     M=20, N=5, K=3 and 6 (8 instances each): heuristics against bp's bound (60 s)
 emax-sweep     coverage against E_max = 4000..9000 at M=20, N=5, K=3 (50 instances per budget)
+table1         Table I timings: M=20, N=5, K=2..6, 30 instances each, on ONE worker
 =============  ===================================================================================
 
 ``--runs R`` sets the random instances per setting of paper-n and paper-k (the paper: 1000, the
@@ -25,7 +26,7 @@ import sys
 import time
 from pathlib import Path
 
-SUITES = ["paper-n", "paper-k", "paper-peers", "exact-small", "paper-gaps", "emax-sweep"]
+SUITES = ["paper-n", "paper-k", "paper-peers", "exact-small", "paper-gaps", "emax-sweep", "table1"]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -51,7 +52,8 @@ def main(argv: list[str] | None = None) -> int:
             runs = args.runs if name in ("paper-n", "paper-k") else None
             suite = load_suite(name, runs=runs)
             t0 = time.monotonic()
-            summary = run_suite(suite, root / name, workers=args.workers, resume=True, progress=not args.quiet)
+            workers = 1 if name == "table1" else args.workers  # one core's timings
+            summary = run_suite(suite, root / name, workers=workers, resume=True, progress=not args.quiet)
             print(f"{name}: ran {summary['ran']} of {summary['jobs']} jobs in {time.monotonic() - t0:.0f} s "
                   f"{summary['counts']}", file=sys.stderr)
     notes = [f"paper-n and paper-k ran with {args.runs} random instances per setting."] if not args.report_only else None
