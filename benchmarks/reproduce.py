@@ -38,6 +38,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--skip", action="append", default=[], choices=SUITES, help="leave a suite out (repeatable)")
     ap.add_argument("--report-only", action="store_true", help="do not run; rewrite the report from stored results")
     ap.add_argument("--quiet", action="store_true", help="no progress bars")
+    ap.add_argument("--note", action="append", default=[], help="a paragraph to add to the report (repeatable)")
     args = ap.parse_args(argv)
 
     from benchmarks.harness import run_suite
@@ -56,7 +57,8 @@ def main(argv: list[str] | None = None) -> int:
             summary = run_suite(suite, root / name, workers=workers, resume=True, progress=not args.quiet)
             print(f"{name}: ran {summary['ran']} of {summary['jobs']} jobs in {time.monotonic() - t0:.0f} s "
                   f"{summary['counts']}", file=sys.stderr)
-    notes = [f"paper-n and paper-k ran with {args.runs} random instances per setting."] if not args.report_only else None
+    notes = ([f"paper-n and paper-k ran with {args.runs} random instances per setting."] if not args.report_only
+             else []) + args.note
     path = write_reference(root, args.out, command=f"python -m benchmarks.reproduce --runs {args.runs}", notes=notes)
     print(f"wrote {path}", file=sys.stderr)
     return 0
