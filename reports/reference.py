@@ -132,6 +132,8 @@ def write_reference(root: str | Path, out: str | Path, *, command: str = "python
     L += ["| suite | jobs | wall (s) | workers | host cpus | finished |", "|---|---|---|---|---|---|"]
     for s in ["paper-n", "paper-k", "paper-peers", "exact-small", "paper-gaps", "emax-sweep", "table1"]:
         for w in _walls(root, s):
+            if not w["jobs"]:
+                continue  # a resume that found everything stored
             L.append(f"| {s} | {w['jobs']} | {w['wall_s']:.0f} | {w['workers']} | {w.get('cpu_count')} | "
                      f"{w['finished_at']} |")
     for name, df in [("paper-n", pn), ("paper-k", pk)]:
@@ -139,9 +141,9 @@ def write_reference(root: str | Path, out: str | Path, *, command: str = "python
             p = df[df["method"].isin(PAPER)]
             L.append("")
             L.append(f"{name}: {p['instance'].nunique()} instances, {len(p)} runs of the five paper methods "
-                     f"({p.groupby('method').size().min() // 5} runs per setting and method); sum of their "
-                     f"method runtimes {p['runtime_s'].sum():.0f} CPU s (= {p['runtime_s'].sum() / 2 / 60:.1f} min "
-                     f"on 2 dedicated cores); all runs verified: "
+                     f"({p.groupby('method').size().min() // 5} runs per setting and method); their runtimes "
+                     f"(wall time inside the jobs) sum to {p['runtime_s'].sum():.0f} s "
+                     f"({p['runtime_s'].sum() / 2 / 60:.1f} min spread over 2 cores); all runs verified: "
                      f"{int((~df['valid'].astype(bool) & df['has_plan']).sum())} invalid plans, "
                      f"{int((df['status'] == 'error').sum())} errors.")
     L.append("")
@@ -234,7 +236,13 @@ def write_reference(root: str | Path, out: str | Path, *, command: str = "python
                 L += [f"Measured at M=20, N=5, K=3 (medians of the per-stage times each run reports): clustering "
                       f"{ocl} ({', '.join(f'{c} {1000 * v:.2f} ms' for c, v in cl.items())}); routing {oro} "
                       f"({', '.join(f'{c} {1000 * v:.1f} ms' for c, v in ro.items())}). The paper: DPC < ADPC < "
-                      "KMeans and GA < PSO < ACO. See Table I below.", ""]
+                      "KMeans and GA < PSO < ACO. See Table I below."]
+                per_k = []
+                for k in [c for c in tab1.columns if isinstance(c, (int, np.integer))]:
+                    col = tab1[k]
+                    per_k.append(f"K={k}: " + " < ".join(sorted(["GA", "PSO", "ACO"], key=lambda c: col[c])) + ", "
+                                 + " < ".join(sorted(["DPC", "ADPC", "KMeans"], key=lambda c: col[c])))
+                L += ["", "Ordering per K (routing, clustering): " + "; ".join(per_k) + ".", ""]
         _ = both
     # -- Table I
     if timing is not None:
