@@ -93,14 +93,6 @@ def build_instance(source: dict):
     return load_instance(source["path"])
 
 
-def ensure_method(name: str) -> None:
-    """Register an ad hoc ``module:function`` method under that name in this process."""
-    from benchmarks.registry import METHODS, MethodSpec
-
-    if name not in METHODS and ":" in name:
-        METHODS[name] = MethodSpec(name, name, False, "ad hoc (named by a suite)")
-
-
 def _now() -> str:
     return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
 
@@ -134,7 +126,6 @@ def run_one(job: dict) -> dict:
         instance = cached_instance(job["source"])
         row.update(kind=instance.kind, n_nodes=instance.n_nodes, n_groups=len(instance.groups),
                    n_vehicles=instance.n_vehicles, e_max=instance.budget)
-        ensure_method(job["method"])
         result, report = run_method(job["method"], instance, seed=job["seed"], time_limit=job["time_limit"])
         rec = result_record(result, report, instance)
         rec.pop("instance", None)

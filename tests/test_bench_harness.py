@@ -280,3 +280,18 @@ def test_progress_bar_counts_and_eta():
         bar.update(status)
     last = stream.getvalue().strip().splitlines()[-1]
     assert "4/4" in last and "100%" in last and "ETA 0:00" in last and "1 error" in last and "1 time_limit" in last
+
+
+def test_ad_hoc_methods_do_not_join_the_registry(tmp_path):
+    """A suite's ``module:function`` method runs, but never shows up in the shared registry."""
+    from benchmarks.registry import METHODS, get_method, run_method
+    from formulations.generate import generate
+    from formulations.instance import to_top
+    from formulations.plan import Status
+
+    before = set(METHODS)
+    inst = to_top(generate(2, 2, 1, 0))
+    result, _ = run_method("bench_methods:all_but_last", inst, time_limit=5.0)
+    assert result.status == Status.FEASIBLE
+    assert get_method("bench_methods:nap").target == "bench_methods:nap"
+    assert set(METHODS) == before
