@@ -164,22 +164,32 @@ def _summary(instance, spec, rec) -> str:
 # -- bench / report -------------------------------------------------------------------------------
 def _add_bench(sub):
     p = sub.add_parser("bench", help="run a benchmark suite (built-in name or TOML file) into a results directory")
-    p.add_argument("suite", nargs="?", default="quick", help="built-in suite (quick, exact-small, paper-n, "
-                   "paper-k, top-chao) or a suite TOML file (default quick)")
+    from benchmarks.suite import builtin_suites
+
+    p.add_argument("suite", nargs="?", default="quick", help=f"built-in suite ({', '.join(builtin_suites())}) "
+                   "or a suite TOML file (default quick)")
     p.add_argument("-o", "--output", help="results directory (default results/<suite>)")
     p.add_argument("--workers", type=_int_at_least(1), help="parallel worker processes (default: all cores)")
     p.add_argument("--resume", action="store_true", help="continue a run: skip jobs already stored")
     p.add_argument("--runs", type=_int_at_least(1), help="random instances per setting (replaces the suite's runs)")
+    p.add_argument("--methods", type=_method_list, help="run only these of the suite's methods, comma-separated")
     p.add_argument("--scheduler", help="run on a Dask cluster, e.g. tcp://HOST:8786")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_bench)
+
+
+def _method_list(text: str) -> list[str]:
+    names = [n.strip() for n in text.split(",")]
+    if not all(names):
+        raise argparse.ArgumentTypeError(f"empty method name in {text!r}")
+    return names
 
 
 def _cmd_bench(args) -> int:
     from benchmarks.harness import run_suite
     from benchmarks.suite import load_suite
 
-    suite = load_suite(args.suite, runs=args.runs)
+    suite = load_suite(args.suite, runs=args.runs, methods=args.methods)
     out = Path(args.output) if args.output else Path("results") / suite.name
     summary = run_suite(suite, out, workers=args.workers, resume=args.resume, scheduler=args.scheduler,
                         progress=not args.quiet)

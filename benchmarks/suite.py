@@ -48,7 +48,7 @@ import importlib
 import itertools
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from formulations.errors import SarcoverError
@@ -119,8 +119,10 @@ def resolve_suite_path(name_or_path: str) -> Path:
     raise SuiteError(f"no suite {name_or_path!r}: not a built-in suite ({known}) nor an existing file")
 
 
-def load_suite(name_or_path: str, *, runs: int | None = None) -> Suite:
-    """Read, validate and expand a suite into jobs. ``runs`` replaces every random set's ``runs``."""
+def load_suite(name_or_path: str, *, runs: int | None = None, methods: list[str] | None = None) -> Suite:
+    """Read, validate and expand a suite into jobs. ``runs`` replaces every random set's ``runs``;
+    ``methods`` keeps only those of the suite's methods (job keys stay the same, so a run of a
+    subset and a later run of the whole suite with ``--resume`` share one results directory)."""
     path = resolve_suite_path(name_or_path)
     where = path.name
     try:
@@ -130,7 +132,15 @@ def load_suite(name_or_path: str, *, runs: int | None = None) -> Suite:
         raise SuiteError(f"suite {where}: not valid TOML ({exc})") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise SuiteError(f"suite {where}: cannot read ({exc})") from None
-    return _build(data, path, text, runs)
+    suite = _build(data, path, text, runs)
+    if methods is not None:
+        unknown = [m for m in methods if m not in suite.methods]
+        if unknown:
+            raise SuiteError(f"suite {where}: --methods names {unknown[0]!r}, not one of the suite's methods "
+                             f"({', '.join(suite.methods)})")
+        keep = [m for m in suite.methods if m in methods]
+        suite = replace(suite, methods=keep, jobs=[j for j in suite.jobs if j.method in keep])
+    return suite
 
 
 def _build(data: dict, path: Path, text: str, runs_override: int | None) -> Suite:

@@ -12,9 +12,11 @@ which then deposits as the elitist ant (without it the ant system found the opti
 
 Vectorised over ants and clusters at once: the colony is (B, P) ants, a step draws every ant's
 next viewpoint by a roulette wheel (a cumulative sum over the candidates and one uniform draw per
-ant), and deposits use one ``np.bincount``. The only Python loop
-is over the L construction steps; with numba (default when importable) those steps run in the
-compiled :func:`heuristics.kernels.construct_tours` on the same draws (same tours, ~10x fewer calls).
+ant), and deposits use one ``np.bincount``; the only Python loop is over the L construction
+steps. With numba (default when importable) whole colonies run compiled
+(:func:`heuristics.kernels.aco_iterations`), 20 at a time between deadline checks, on uniforms
+drawn by numpy in the same stream: the same tours as the numpy loop but for exact length ties
+(a tour and its reverse when start = end), which the two paths' sums may break differently.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from heuristics.kernels import HAVE_NUMBA
 from heuristics.tour import ClusterBatch, best_two_opt_moves, invert
 
 if HAVE_NUMBA:
-    from heuristics.kernels import construct_tours
+    from heuristics.kernels import aco_iterations
 
 _PAD = -1e300
 # Weight of a pad: absorbed in the wheel's total (≥ 1e-20 while real viewpoints remain, since
@@ -35,6 +37,7 @@ _PAD = -1e300
 # Real weights are floored at 1e-20 (float32 keeps them apart from pads) before normalisation.
 _PAD_WEIGHT = 1e-30  # normal in float32 (subnormals are slow), absorbed next to 1e-20
 _MIN_WEIGHT = 1e-20
+_CHUNK = 20  # compiled colonies between two deadline checks
 
 
 class ACORouter:
@@ -78,6 +81,21 @@ class ACORouter:
         best_f = np.full(B, np.inf)
         best = np.tile(np.arange(L), (B, 1))
         polished = np.zeros(B, dtype=bool)  # best tour is 2-opt optimal and unchanged since
+        if self.use_numba:  # whole colonies compiled, _CHUNK at a time between deadline checks
+            nodes, sizes = np.ascontiguousarray(batch.nodes), np.ascontiguousarray(batch.sizes)
+            Dc, log_eta = np.ascontiguousarray(D, dtype=float), np.ascontiguousarray(log_eta)
+            U = np.empty((min(_CHUNK, self.n_iterations), L, B, P), dtype=np.float32)
+            done = 0
+            while done < self.n_iterations:
+                if deadline is not None and time.perf_counter() > deadline:
+                    break
+                n = min(_CHUNK, self.n_iterations - done)
+                rng.random(out=U[:n], dtype=np.float32)  # the same stream as per-colony draws
+                aco_iterations(tau, log_eta, nodes, sizes, Dc, batch.start, batch.end, U, n, done == 0,
+                               self.alpha, self.rho, self.elitist, best, best_f, polished,
+                               self.local_search)
+                done += n
+            return best, best_f
         for it in range(self.n_iterations):
             if deadline is not None and time.perf_counter() > deadline:
                 break
@@ -86,21 +104,18 @@ class ACORouter:
             weight[pad3] = _PAD_WEIGHT
             weight = weight.astype(np.float32).reshape(B * (L + 1), L)
             u = rng.random((L, B, P), dtype=np.float32) * np.float32(1.0 - 1e-6)  # r < total
-            if self.use_numba:  # same wheel, same draws, compiled (heuristics.kernels)
-                tours = construct_tours(weight, u, B, P, L)
-            else:
-                avail = np.ones(B * P * L, dtype=np.float32)
-                cur = np.full((B, P), L) + row_state
-                tours = np.empty((L, B, P), dtype=int)
-                for s in range(L - 1):
-                    w = np.take(weight, cur, axis=0)
-                    w *= avail.reshape(B, P, L)
-                    np.cumsum(w, axis=-1, out=w)  # roulette wheel over the unvisited
-                    nxt = np.argmax(w > (u[s] * w[..., -1])[..., None], axis=-1)
-                    tours[s] = nxt
-                    avail[ant_base + nxt] = 0.0
-                    cur = row_state + nxt
-                tours[L - 1] = np.argmax(avail.reshape(B, P, L), axis=-1)  # the one left
+            avail = np.ones(B * P * L, dtype=np.float32)
+            cur = np.full((B, P), L) + row_state
+            tours = np.empty((L, B, P), dtype=int)
+            for s in range(L - 1):
+                w = np.take(weight, cur, axis=0)
+                w *= avail.reshape(B, P, L)
+                np.cumsum(w, axis=-1, out=w)  # roulette wheel over the unvisited
+                nxt = np.argmax(w > (u[s] * w[..., -1])[..., None], axis=-1)
+                tours[s] = nxt
+                avail[ant_base + nxt] = 0.0
+                cur = row_state + nxt
+            tours[L - 1] = np.argmax(avail.reshape(B, P, L), axis=-1)  # the one left
             tours = tours.transpose(1, 2, 0)
             f = batch.lengths(D, tours)
             k = np.argmin(f, axis=1)

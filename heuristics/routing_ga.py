@@ -10,8 +10,10 @@ positions left to right with the missing viewpoints in parent 2's order) with pr
 Like the PSO, all clusters run in one (B, P, L) batch: a row's pads sit in the tail positions of
 every individual and stay there (cuts and inversions are drawn inside the real positions), so
 no per-individual Python loop is needed; OX is done for the whole batch with two scatters.
-With numba (default when importable) crossover and mutation of all children run in the compiled
-:func:`heuristics.kernels.ga_children` on the same draws (same children); fitness stays in numpy.
+With numba (default when importable) a whole generation (elitism, tournaments, OX, inversion,
+fitness) runs in the compiled :func:`heuristics.kernels.ga_generation` on the same draws as the
+numpy generation; only the draws stay in Python (the same children, but for ties between
+lengths summed in another order).
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from heuristics.kernels import HAVE_NUMBA
 from heuristics.tour import ClusterBatch, invert
 
 if HAVE_NUMBA:
-    from heuristics.kernels import ga_children
+    from heuristics.kernels import ga_generation
 
 
 def order_crossover(p1: np.ndarray, p2: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -78,9 +80,20 @@ class GARouter:
         f = batch.lengths(D, pop)
         rows = np.arange(B)[:, None]
         sizes = np.repeat(batch.sizes, C)  # one entry per child, row-major (B, C)
+        if self.use_numba:
+            nodes = np.ascontiguousarray(batch.nodes)
+            bsizes = np.ascontiguousarray(batch.sizes)
+            Dc = np.ascontiguousarray(D, dtype=float)
         for _ in range(self.n_iterations):
             if deadline is not None and time.perf_counter() > deadline:
                 break
+            if self.use_numba:  # the same draws, in the same order, as the numpy generation below
+                t = rng.integers(0, P, size=(B, 2 * C, 2))
+                ra, rb, rc = rng.random(B * C), rng.random(B * C), rng.random(B * C)
+                rd, re, rm = rng.random(B * C), rng.random(B * C), rng.random(B * C)
+                pop, f = ga_generation(pop, f, t, ra, rb, rc, rd, re, rm, self.p_crossover,
+                                       self.p_mutation, E, Dc, nodes, bsizes, batch.start, batch.end)
+                continue
             rank = np.argsort(f, axis=1, kind="stable")
             elite = pop[rows, rank[:, :E]]
             elite_f = f[rows, rank[:, :E]]
@@ -90,14 +103,11 @@ class GARouter:
             cross = rng.random(B * C) < self.p_crossover
             lo2, hi2 = _cuts(rng, sizes)
             mutate = rng.random(B * C) < self.p_mutation
-            if self.use_numba:  # same children from the same draws, compiled (heuristics.kernels)
-                child = ga_children(pop, win, lo1, hi1, cross, lo2, hi2, mutate)
-            else:
-                p1 = pop[rows, win[:, :C]].reshape(B * C, L)
-                p2 = pop[rows, win[:, C:]].reshape(B * C, L)
-                child = np.where(cross[:, None], order_crossover(p1, p2, lo1, hi1), p1)
-                child = invert(child, np.where(mutate, lo2, 1), np.where(mutate, hi2, 0))
-                child = child.reshape(B, C, L)
+            p1 = pop[rows, win[:, :C]].reshape(B * C, L)
+            p2 = pop[rows, win[:, C:]].reshape(B * C, L)
+            child = np.where(cross[:, None], order_crossover(p1, p2, lo1, hi1), p1)
+            child = invert(child, np.where(mutate, lo2, 1), np.where(mutate, hi2, 0))
+            child = child.reshape(B, C, L)
             pop = np.concatenate([elite, child], axis=1)
             f = np.concatenate([elite_f, batch.lengths(D, child)], axis=1)
         best = np.argmin(f, axis=1)

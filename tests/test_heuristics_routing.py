@@ -112,3 +112,22 @@ def test_invert_and_two_opt():
     route = two_opt(D, [1, 2, 3, 4], 0, 5)
     assert route_length(D, route, 0, 5) < route_length(D, [1, 2, 3, 4], 0, 5)
     assert sorted(route.tolist()) == [1, 2, 3, 4]
+
+
+@pytest.mark.parametrize("name", ROUTERS)
+@pytest.mark.parametrize("seed", range(5))
+def test_compiled_kernels_match_numpy(name, seed):
+    """The numba kernels run the numpy algorithm on the same draws: the same tours and lengths.
+
+    Start and end differ, so no tour ties with its reverse (the two paths sum lengths in another
+    order, which may break such exact ties differently)."""
+    g = np.random.default_rng(100 + seed)
+    pts = np.vstack([[0, 0], g.uniform(0, 1000, (40, 2)), [1000, 300]])
+    D = np.sqrt(((pts[:, None] - pts[None]) ** 2).sum(axis=-1))
+    clusters = np.split(g.permutation(np.arange(1, 41)), np.cumsum([14, 9, 11, 6]))[:4]
+    fast, f_fast, _ = solve(ROUTERS[name](use_numba=True), D, clusters, seed)
+    slow, f_slow, _ = solve(ROUTERS[name](use_numba=False), D, clusters, seed)
+    assert all(np.array_equal(a, b) for a, b in zip(fast, slow))
+    np.testing.assert_allclose(f_fast, f_slow, rtol=1e-12)
+    lengths = [route_length(D, r, 0, 41) for r in fast]
+    np.testing.assert_allclose(f_fast, lengths, rtol=1e-12)
