@@ -85,7 +85,7 @@ class Repairer:
             rs.visited[route] = True
         return rs
 
-    def _cover(self, rs: RouteSet, reach: np.ndarray) -> int | None:
+    def cover(self, rs: RouteSet, reach: np.ndarray) -> int | None:
         """Insert a view of each uncovered group; return a group that cannot be, or None.
 
         Greedy's group phase, hardest group first: the group whose cheapest feasible insertion
@@ -134,7 +134,7 @@ class Repairer:
             score(r)
         return None
 
-    def _fill(self, rs: RouteSet, reach: np.ndarray) -> int:
+    def fill(self, rs: RouteSet, reach: np.ndarray) -> int:
         """Insert free reachable viewpoints by greatest prize per added energy while any fits.
 
         Same rule as greedy's second phase; scores are kept per route and only the route that
@@ -236,9 +236,9 @@ class Repairer:
         reach = np.zeros(inst.n_nodes + 2, dtype=bool)
         reach[1:-1] = inst.reachable()
         rs = self._routeset(fixed)
-        missing = self._cover(rs, reach)
+        missing = self.cover(rs, reach)
         while missing is not None and self._make_room(rs, missing, reach):
-            missing = self._cover(rs, reach)
+            missing = self.cover(rs, reach)
         if missing is not None:
             self.stats["stripped"] = True
             stripped = []
@@ -251,19 +251,19 @@ class Repairer:
                         keep.append(v)
                 stripped.append(self._polish(keep))
             rs = self._routeset(stripped)
-            missing = self._cover(rs, reach)
+            missing = self.cover(rs, reach)
         if missing is not None:
             self.stats["rebuilt"] = True
             rs = self._routeset([])
-            missing = self._cover(rs, reach)
+            missing = self.cover(rs, reach)
             if missing is not None:
                 what = "target" if inst.kind == "sar" else "group"
                 raise RepairFailed(f"repair could not fit a viewpoint of {what} {missing} into any route")
         if reinsert:
-            self.stats["reinserted"] += self._fill(rs, reach)
+            self.stats["reinserted"] += self.fill(rs, reach)
             for r in range(len(rs.routes)):
                 if len(rs.routes[r]) > 2:
                     rs.routes[r] = self._polish(rs.routes[r])
                     rs.energy[r] = self.energy(rs.routes[r])
-            self.stats["reinserted"] += self._fill(rs, reach)
+            self.stats["reinserted"] += self.fill(rs, reach)
         return [list(r) for r in rs.routes]

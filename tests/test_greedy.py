@@ -29,3 +29,17 @@ def test_greedy_plans_always_verified(seed):
         assert res.objective == rep.covered
     else:
         assert res.plan is None and res.reason
+
+
+def test_greedy_rules_by_hand():
+    """Hardest group first, then prize per energy: on a line, the far group's view goes in first.
+
+    Nodes at x = 1, 2 (group 0) and x = 5 (group 1, its only view), one vehicle, budget 10:
+    group 1 (cheapest insertion 10) before group 0 (2), then node 2 (prize 3) fits, node 1 too."""
+    from formulations.instance import TOPInstance
+
+    inst = TOPInstance(coords=np.array([[1.0, 0.0], [2.0, 0.0], [5.0, 0.0]]), prizes=np.array([1.0, 3.0, 1.0]),
+                       start=np.zeros(2), end=np.zeros(2), budget=10.0, n_vehicles=1, groups=[[0, 1], [2]])
+    res, rep = run_method("greedy", inst)
+    assert res.status == Status.FEASIBLE and rep.valid
+    assert res.plan.routes == ((0, 1, 2),) and res.objective == 5.0
