@@ -170,23 +170,41 @@ class TOPInstance:
         """All points in solver order: index 0 = start, 1..V = nodes, V+1 = end."""
         return np.vstack([self.start[None, :], self.coords, self.end[None, :]])
 
+    def _cached(self, name: str, make) -> np.ndarray:
+        """A read-only array computed once per instance (the instance is immutable)."""
+        cache = self.__dict__.setdefault("_cache", {})
+        if name not in cache:
+            value = make()
+            value.setflags(write=False)
+            cache[name] = value
+        return cache[name]
+
     def distance_matrix(self) -> np.ndarray:
-        """(V+2, V+2) Euclidean distances in solver order (see :meth:`depot_coords`)."""
-        pts = self.depot_coords()
-        diff = pts[:, None, :] - pts[None, :, :]
-        return np.sqrt((diff**2).sum(axis=-1))
+        """(V+2, V+2) Euclidean distances in solver order (see :meth:`depot_coords`); read-only."""
+        def make():
+            pts = self.depot_coords()
+            diff = pts[:, None, :] - pts[None, :, :]
+            return np.sqrt((diff**2).sum(axis=-1))
+
+        return self._cached("distance", make)
 
     def cost_matrix(self) -> np.ndarray:
-        """(V+2, V+2) arc energies c_ij = e_fly·d_ij + e_image·[j is a node], solver order."""
-        cost = self.e_fly * self.distance_matrix()
-        cost[:, 1 : self.n_nodes + 1] += self.e_image
-        return cost
+        """(V+2, V+2) arc energies c_ij = e_fly·d_ij + e_image·[j is a node], solver order; read-only."""
+        def make():
+            cost = self.e_fly * self.distance_matrix()
+            cost[:, 1 : self.n_nodes + 1] += self.e_image
+            return cost
+
+        return self._cached("cost", make)
 
     def round_trip_cost(self) -> np.ndarray:
-        """(V,) energy of the route start → node → end alone."""
-        cost = self.cost_matrix()
-        idx = np.arange(1, self.n_nodes + 1)
-        return cost[0, idx] + cost[idx, self.n_nodes + 1]
+        """(V,) energy of the route start → node → end alone; read-only."""
+        def make():
+            cost = self.cost_matrix()
+            idx = np.arange(1, self.n_nodes + 1)
+            return cost[0, idx] + cost[idx, self.n_nodes + 1]
+
+        return self._cached("round_trip", make)
 
     def reachable(self) -> np.ndarray:
         """(V,) bool: nodes some vehicle can visit alone and still end within the budget."""
