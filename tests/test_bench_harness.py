@@ -295,3 +295,19 @@ def test_ad_hoc_methods_do_not_join_the_registry(tmp_path):
     assert result.status == Status.FEASIBLE
     assert get_method("bench_methods:nap").target == "bench_methods:nap"
     assert set(METHODS) == before
+
+
+def test_methods_subset_then_rest_with_resume(tmp_path, capsys):
+    """--methods runs only those of a suite's methods; a later --resume of the whole suite runs the rest."""
+    suite = write_suite(tmp_path, SMALL)
+    out = tmp_path / "res"
+    assert main(["bench", str(suite), "-o", str(out), "--methods", "greedy", "--quiet"]) == 0
+    rows = rows_of(out)
+    assert len(rows) == 5 and {r["method"] for r in rows} == {"greedy"}
+    assert main(["bench", str(suite), "-o", str(out), "--resume", "--quiet"]) == 0
+    rows = rows_of(out)
+    assert len(rows) == 10 and len({r["key"] for r in rows}) == 10
+    capsys.readouterr()
+    assert main(["bench", str(suite), "-o", str(tmp_path / "x"), "--methods", "greedy,milp"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "'milp'" in err and "not one of the suite's methods" in err

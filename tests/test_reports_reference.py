@@ -36,3 +36,26 @@ def test_reference_report_counts_runs(tiny_root, tmp_path):
     tab = pd.read_csv(tmp_path / "out" / "coverage_vs_N.csv")
     assert set(tab["N"]) == {2, 3, 4, 5, 6}
     assert (tab["runs"] == 1).all() and tab["mean"].between(0, 1).all()
+
+
+def test_top_table_checks_against_published_optima():
+    """Per set and method: proven only when optimal AND equal to the published value; wrong optima,
+    bounds below and plans above the published optimum are counted, never hidden."""
+    import pandas as pd
+
+    from reports.reference import top_table
+
+    rows = [  # instance, method, status, objective, bound, reference, runtime
+        ("p1.2.a", "milp", "optimal", 10.0, 10.0, 10.0, 1.0),
+        ("p1.2.b", "milp", "optimal", 15.0, 15.0, 20.0, 2.0),      # wrong "optimal"
+        ("p1.3.c", "milp", "time_limit", 30.0, 35.0, 40.0, 60.0),  # bound below the optimum (so is 15 < 20)
+        ("p2.2.a", "milp", "time_limit", 50.0, 55.0, 50.0, 60.0),  # honest open instance
+        ("p2.2.b", "greedy", "feasible", 40.0, None, 50.0, 0.01),  # heuristics are left out
+    ]
+    df = pd.DataFrame(rows, columns=["instance", "method", "status", "objective", "bound", "reference", "runtime_s"])
+    df["exact"] = df["method"] != "greedy"
+    t = top_table(df).set_index("set")
+    assert list(t["method"]) == ["milp", "milp"]
+    assert t.loc[1, "files"] == 3 and t.loc[1, "proven"] == 1 and t.loc[1, "wrong_optimal"] == 1
+    assert t.loc[1, "bound_below_optimum"] == 2 and t.loc[1, "median_s_proven"] == 1.0
+    assert t.loc[2, "proven"] == 0 and abs(t.loc[2, "bound_gap_unproven"] - 0.1) < 1e-12
