@@ -76,6 +76,18 @@ if HAVE_NUMBA:
         return tours
 
     @njit(cache=True, nogil=True)
+    def _path_length(D, row_nodes, local, n, start, end):  # pragma: no cover - compiled
+        """Length of start → row_nodes[local[0]] → … → row_nodes[local[n-1]] → end, summed in order
+        (pads after the n real positions would add D[end, end] = 0)."""
+        prev = start
+        total = 0.0
+        for i in range(n):
+            node = row_nodes[local[i]]
+            total += D[prev, node]
+            prev = node
+        return total + D[prev, end]
+
+    @njit(cache=True, nogil=True)
     def keyed_lengths(D, keys, nodes, sizes, start, end):  # pragma: no cover - compiled
         """(B, P) lengths of the tours decoded from keys (B, P, L) (real entries sorted by key)."""
         B, P, L = keys.shape
@@ -91,13 +103,7 @@ if HAVE_NUMBA:
                         order[j] = order[j - 1]
                         j -= 1
                     order[j] = i
-                prev = start
-                total = 0.0
-                for i in range(n):
-                    v = nodes[b, order[i]]
-                    total += D[prev, v]
-                    prev = v
-                out[b, p] = total + D[prev, end]
+                out[b, p] = _path_length(D, nodes[b], order, n, start, end)
         return out
 
     @njit(cache=True, nogil=True)
@@ -231,13 +237,7 @@ if HAVE_NUMBA:
                         v[b, p, i] = vi
                         x[b, p, i] = x[b, p, i] + vi
                     _sort_real(x[b, p], n, order)
-                    prev = start
-                    total = 0.0
-                    for i in range(n):
-                        node = nodes[b, order[i]]
-                        total += D[prev, node]
-                        prev = node
-                    total += D[prev, end]
+                    total = _path_length(D, nodes[b], order, n, start, end)
                     if total < pbest_f[b, p]:
                         pbest_f[b, p] = total
                         for i in range(n):
@@ -315,13 +315,7 @@ if HAVE_NUMBA:
             for b in range(B):
                 k = 0
                 for p in range(P):
-                    prev = start
-                    total = 0.0
-                    for s in range(L):
-                        node = nodes[b, tours[s, b, p]]
-                        total += D[prev, node]
-                        prev = node
-                    f[b, p] = total + D[prev, end]
+                    f[b, p] = _path_length(D, nodes[b], tours[:, b, p], sizes[b], start, end)
                     if f[b, p] < f[b, k]:
                         k = p
                 if f[b, k] < best_f[b]:
@@ -425,13 +419,7 @@ if HAVE_NUMBA:
         child = ga_children(pop, win, lo1, hi1, cross, lo2, hi2, mutate)
         for b in range(B):
             for c in range(C):
-                prev = start
-                total = 0.0
-                for i in range(L):
-                    node = nodes[b, child[b, c, i]]
-                    total += D[prev, node]
-                    prev = node
-                nf[b, E + c] = total + D[prev, end]
+                nf[b, E + c] = _path_length(D, nodes[b], child[b, c], sizes[b], start, end)
                 for i in range(L):
                     new[b, E + c, i] = child[b, c, i]
         return new, nf
