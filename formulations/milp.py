@@ -38,6 +38,19 @@ the prize lattice step; the model budget is the verifier's own acceptance thresh
 the verifier accepts is cut off (the bound is valid). A plan HiGHS returns that the verifier
 rejects (possible only within HiGHS's feasibility tolerance) is never reported: its route is cut
 off by a no-good cut, which removes only that infeasible route, and the model is re-solved.
+
+Anytime history (``info["history"]``, see :mod:`formulations.history`): ``[t, incumbent, bound]``
+points in prize units, t from the call of :func:`solve_milp`. Incumbents are verified plans only:
+the warm start, and every improving MIP solution HiGHS reports (``cbMipImprovingSolution``, read
+back into routes; a solution with subtours counts with its routes from the depot only, and only
+if the verifier accepts them), so every incumbent is at most the optimum. Bounds are the LP bound
+after each root cut round, and HiGHS's MIP dual bound during every solve of the loop
+(``cbMipInterrupt``) and at its end, each rounded down to the prize lattice. They are all valid:
+every model in the loop, relaxed or not and before or after any cut, is a relaxation of the
+verifier's problem (the cuts are connectivity cuts, valid for every plan, and no-good cuts that
+remove only routes the verifier rejects), so its LP or MIP dual bound is at least the optimum.
+The callbacks are installed on the ``highspy.Highs`` object behind Pyomo's interface (a private
+attribute); if that is not reachable, only the points at the end of each solve are recorded.
 """
 
 from __future__ import annotations
@@ -53,6 +66,7 @@ from pyomo.contrib.solver.common.results import TerminationCondition
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import maximum_flow
 
+from formulations.history import History
 from formulations.instance import TOPInstance, precheck
 from formulations.plan import Plan, Result, Status
 from formulations.preprocess import (
@@ -326,6 +340,60 @@ def _set_warm_start(opt, m, plan: Plan, g: ArcGraph) -> bool:
     return True
 
 
+def _install_history(opt, m, instance: TOPInstance, g: ArcGraph, lattice, best: _Best, hist: History) -> bool:
+    """Report HiGHS's improving solutions and dual bounds to ``hist`` while it solves.
+
+    Wraps the Pyomo interface's ``_solve`` so that the callbacks are subscribed on whichever
+    ``highspy.Highs`` object it holds when a solve starts (``set_instance`` makes a new one).
+    An improving solution is decoded into routes and verified; a valid one that beats ``best``
+    replaces it. Callbacks never raise into HiGHS. Returns False (nothing installed) if the
+    private attributes this relies on are missing.
+    """
+    solve = getattr(opt, "_solve", None)
+    if solve is None or not hasattr(opt, "_solver_model") or not hasattr(opt, "_pyomo_var_to_solver_var_map"):
+        return False
+    hooked: dict = {"highs": None, "cols": None}
+
+    def dual(e) -> float | None:
+        b = float(e.data_out.mip_dual_bound)  # HiGHS reports it in the model's (maximisation) sense
+        return floor_to_lattice(b, lattice) if math.isfinite(b) else None
+
+    def on_interrupt(e) -> None:
+        try:
+            hist.update(bound=dual(e))
+        except Exception:  # noqa: BLE001 - a recording failure must not stop the solve
+            pass
+
+    def on_solution(e) -> None:
+        try:
+            sol = e.data_out.mip_solution
+            xval = {a: float(sol[c]) for a, c in hooked["cols"]}
+            routes, _, _ = _routes(g, xval)
+            plan = _to_plan(routes)
+            rep = verify(instance, plan)
+            if rep.valid and rep.prize > best.prize:
+                best.plan, best.prize = plan, rep.prize
+            hist.update(incumbent=best.prize if best.plan is not None else None, bound=dual(e))
+        except Exception:  # noqa: BLE001
+            pass
+
+    def wrapped():
+        h = opt._solver_model
+        if h is not None and h is not hooked["highs"]:
+            try:
+                cmap = opt._pyomo_var_to_solver_var_map
+                hooked["cols"] = [(a, cmap[id(m.x[a])]) for a in m.A]
+                h.cbMipImprovingSolution.subscribe(on_solution)
+                h.cbMipInterrupt.subscribe(on_interrupt)
+                hooked["highs"] = h
+            except Exception:  # noqa: BLE001 - fall back to the points at the end of each solve
+                hooked["highs"] = h
+        return solve()
+
+    opt._solve = wrapped
+    return True
+
+
 def solve_milp(
     instance: TOPInstance,
     *,
@@ -349,11 +417,13 @@ def solve_milp(
     t0 = time.perf_counter()
     deadline = None if time_limit is None else t0 + float(time_limit)
     info: dict = {"threads": threads, "seed": seed}
+    hist = History(t0)
 
     def left() -> float | None:
         return None if deadline is None else max(deadline - time.perf_counter(), 0.0)
 
     def done(status, plan=None, bound=None, reason=""):
+        info["history"] = hist.finish(verify(instance, plan).prize if plan is not None else None, bound)
         info["runtime_model_s"] = round(time.perf_counter() - t0, 4)
         return Result(METHOD, status, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
                       reason=reason, info=info)
@@ -378,6 +448,13 @@ def solve_milp(
     }
     common = dict(raise_exception_on_nonoptimal_result=False, load_solutions=False, tee=tee,
                   solver_options=options)
+    best = _Best()
+    if warm_start is not None:
+        rep0 = verify(instance, warm_start)
+        if rep0.valid:  # the warm start is an incumbent from the start (HiGHS gets it too)
+            best.plan, best.prize = warm_start, rep0.prize
+            hist.update(incumbent=rep0.prize)
+    info["history_callbacks"] = _install_history(opt, m, instance, g, lattice, best, hist)
 
     # Every bound seen is valid (each model relaxes the problem); keep the smallest. The trivial
     # one: every reachable node visited.
@@ -401,6 +478,7 @@ def solve_milp(
             res.solution_loader.load_vars()
             lp_bounds.append(round(float(res.incumbent_objective), 6))
             bound = min(bound, floor_to_lattice(float(res.incumbent_objective), lattice))
+            hist.update(bound=bound)
             xval, yval = _values(m.x), _values(m.y)
             n = _separate_lp(m, g, xval, yval)
             if cliques:
@@ -418,7 +496,6 @@ def solve_milp(
     info["cuts_lp"] = cuts_lp
     info["cuts_clique"] = cuts_clique
 
-    best = _Best()
     rounds, cuts_int, nogoods, warm = 0, 0, 0, False
     while True:
         rounds += 1
@@ -442,6 +519,9 @@ def solve_milp(
                                f"budget covers every {what}")
         if res.objective_bound is not None and math.isfinite(res.objective_bound):
             bound = min(bound, floor_to_lattice(float(res.objective_bound), lattice))
+        if hist.bound is not None:  # a dual bound seen during the solve (all valid, see the module doc)
+            bound = min(bound, hist.bound)
+        hist.update(bound=bound)
         if tc not in (TerminationCondition.convergenceCriteriaSatisfied, TerminationCondition.maxTimeLimit):
             info.update(rounds=rounds)
             return done(Status.ERROR, plan=best.plan, bound=bound, reason=f"HiGHS stopped: {tc.name}")
@@ -454,7 +534,8 @@ def solve_milp(
         plan = _to_plan(routes)
         report = verify(instance, plan)
         if report.valid and report.prize > best.prize:
-            best = _Best(plan, report.prize)
+            best.plan, best.prize = plan, report.prize
+        hist.update(incumbent=best.prize if best.plan is not None else None)
         changed = False
         if stray:  # subtours among coincident points: cut them off and re-solve
             for cyc in _cycles(stray, succ):
@@ -476,8 +557,6 @@ def solve_milp(
         break
 
     info.update(rounds=rounds, cuts_int=cuts_int, nogoods=nogoods, warm_start=warm)
-    if best.plan is None and warm_start is not None and verify(instance, warm_start).valid:
-        best = _Best(warm_start, verify(instance, warm_start).prize)
     if best.plan is not None and best.prize >= bound - 1e-7 * max(1.0, abs(bound)):
         return done(Status.OPTIMAL, plan=best.plan, bound=bound)  # a verified plan reaches a proven bound
     if status == Status.OPTIMAL:  # HiGHS optimal, yet the verified plan is below its bound: never claim it

@@ -1,0 +1,63 @@
+"""Anytime history of an exact method: incumbent and bound against time.
+
+``Result.info["history"]`` is a list of ``[t, incumbent, bound]``: ``t`` seconds since the method
+was called, ``incumbent`` the best verified objective found so far (None before the first plan)
+and ``bound`` the best proven upper bound so far (None before the first one), both in the
+objective's units. A point is appended whenever either improves, and a last point at the end
+holds exactly the method's final objective and bound. Plain floats and None only, so a result
+row stays JSON; thinned to at most :data:`MAX_POINTS` points (first and last always kept).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+MAX_POINTS = 200
+_EPS = 1e-9
+
+
+def thin(points: list, max_points: int = MAX_POINTS) -> list:
+    """At most ``max_points`` of ``points``, evenly spread by index; first and last kept."""
+    if len(points) <= max_points:
+        return list(points)
+    step = (len(points) - 1) / (max_points - 1)
+    keep = sorted({round(k * step) for k in range(max_points)} | {0, len(points) - 1})
+    return [points[i] for i in keep]
+
+
+def shifted(points: list, dt: float) -> list:
+    """The history with every time moved by ``dt`` (a wrapper that ran a heuristic first)."""
+    return [[round(t + dt, 4), inc, bnd] for t, inc, bnd in points]
+
+
+class History:
+    """Records the running best incumbent (max) and bound (min) with their times."""
+
+    def __init__(self, t0: float | None = None):
+        self.t0 = time.perf_counter() if t0 is None else t0
+        self.points: list[list] = []
+        self.incumbent: float | None = None
+        self.bound: float | None = None
+
+    def update(self, incumbent: float | None = None, bound: float | None = None) -> bool:
+        """Take a new verified objective and/or a new valid bound; log a point if either improves."""
+        changed = False
+        if incumbent is not None and math.isfinite(incumbent) and (
+                self.incumbent is None or incumbent > self.incumbent + _EPS * max(1.0, abs(incumbent))):
+            self.incumbent = float(incumbent)
+            changed = True
+        if bound is not None and math.isfinite(bound) and (
+                self.bound is None or bound < self.bound - _EPS * max(1.0, abs(bound))):
+            self.bound = float(bound)
+            changed = True
+        if changed:
+            self.points.append([round(time.perf_counter() - self.t0, 4), self.incumbent, self.bound])
+        return changed
+
+    def finish(self, incumbent: float | None, bound: float | None) -> list:
+        """Append the final point (the method's own objective and bound) and return the thinned list."""
+        inc = None if incumbent is None or not math.isfinite(incumbent) else float(incumbent)
+        bnd = None if bound is None or not math.isfinite(bound) else float(bound)
+        self.points.append([round(time.perf_counter() - self.t0, 4), inc, bnd])
+        return thin(self.points)
