@@ -45,6 +45,16 @@ value reaches that bound, otherwise FEASIBLE with the relaxed bound. So scaling 
 Prizes must be integers or decimals with at most 6 digits; they are scaled by the smallest power
 of ten that makes them integral (exact), anything else raises :class:`CpsatInputError`.
 
+Anytime history (``info["history"]``, see :mod:`formulations.history`): ``[t, incumbent, bound]``
+points in prize units (scaled objective / prize scale), t from the call of :func:`solve_cpsat`.
+Incumbents: every solution CP-SAT reports (a solution callback) is read back into routes and
+verified; only truly feasible plans count, so every incumbent is at most the optimum (and the
+best of them is returned if the final plan is worse, e.g. a relaxed incumbent that had to be
+repaired). Bounds: only the relaxed model's, from ``best_bound_callback`` (and the final one),
+as ⌈bound - 1e-6⌉ / prize scale: the relaxed model is a relaxation of the true problem, so they
+are valid. The safe model is a restriction (capped at the relaxed bound), so its bounds say
+nothing about the true problem and are never recorded; only its verified plans are.
+
 Warm start: ``solve_cpsat(..., hint=plan)`` passes a plan as a CP-SAT hint. Formulations do not
 import heuristics, so the registered ``cpsat`` method runs without a hint (CP-SAT's own first
 solutions arrive within milliseconds on these sizes); callers that have a heuristic plan may
@@ -60,6 +70,7 @@ import numpy as np
 from ortools.sat.python import cp_model
 
 from formulations.errors import SarcoverError
+from formulations.history import History
 from formulations.instance import TOPInstance, precheck
 from formulations.plan import Plan, Result, Status
 from formulations.verify import REL_TOL, verify
@@ -333,6 +344,25 @@ def _repair(instance: TOPInstance, routes: list[list[int]]) -> Plan | None:
     return None
 
 
+class _Recorder(cp_model.CpSolverSolutionCallback):
+    """Verifies each solution CP-SAT reports; keeps the best truly feasible plan, logs it to ``hist``."""
+
+    def __init__(self, built: _Model, hist: History, best: dict):
+        super().__init__()
+        self.built, self.hist, self.best = built, hist, best
+
+    def on_solution_callback(self) -> None:
+        try:
+            inst = self.built.data.instance
+            plan = _pad(self.built.routes(self), inst.n_vehicles)
+            rep = verify(inst, plan)
+            if rep.valid and (self.best["plan"] is None or rep.prize > self.best["prize"]):
+                self.best.update(plan=plan, prize=rep.prize)
+                self.hist.update(incumbent=rep.prize)
+        except Exception:  # noqa: BLE001 - a recording failure must not stop the search
+            pass
+
+
 def _solver(time_left: float | None, threads: int, seed: int, linearization: int = 2) -> cp_model.CpSolver:
     s = cp_model.CpSolver()
     s.parameters.linearization_level = int(linearization)
@@ -357,11 +387,21 @@ def solve_cpsat(
     """Solve ``instance`` with CP-SAT; OPTIMAL only when proven for the unscaled problem."""
     t0 = time.perf_counter()
     info: dict = {"threads": int(threads), "model": model, "flow": flow, "linearization": linearization}
+    hist = History(t0)
+    best: dict = {"plan": None, "prize": -math.inf}  # best verified plan the callbacks saw
 
     def left() -> float | None:
         return None if time_limit is None else time_limit - (time.perf_counter() - t0)
 
     def done(status, plan=None, bound=None, reason=""):
+        prize = verify(instance, plan).prize if plan is not None else None
+        if status != Status.OPTIMAL and best["plan"] is not None and (prize is None or best["prize"] > prize):
+            # a truly feasible plan seen during the search beats the final one (e.g. a repaired one)
+            plan, prize = best["plan"], best["prize"]
+            if status == Status.NO_PLAN:
+                status = Status.FEASIBLE
+            reason = (reason + "; " if reason else "") + "returned the best verified plan seen during the search"
+        info["history"] = hist.finish(prize, bound)
         return Result("cpsat", status, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
                       reason=reason, info=info)
 
@@ -380,7 +420,9 @@ def solve_cpsat(
     if hint is not None:
         built.add_hint(hint)
     solver = _solver(left(), threads, seed, linearization)
-    st = solver.solve(built.m)
+    # CP-SAT's bound on the scaled objective; the relaxed model's bound is valid for the true problem.
+    solver.best_bound_callback = lambda b: hist.update(bound=math.ceil(b - 1e-6) / pscale)
+    st = solver.solve(built.m, _Recorder(built, hist, best))
     info["relaxed_status"] = solver.status_name(st)
     info["relaxed_wall_s"] = solver.wall_time
     if st == cp_model.INFEASIBLE:
@@ -389,10 +431,12 @@ def solve_cpsat(
     if st == cp_model.MODEL_INVALID:
         return done(Status.ERROR, reason="CP-SAT: model invalid " + built.m.validate())
     if st not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
-        # No incumbent: CP-SAT's best_objective_bound is not reliable then (it reads 0), so no bound.
+        # No incumbent: CP-SAT's best_objective_bound is not reliable then (it reads 0); the last
+        # bound its callback reported is (None if it reported none).
         if hint is not None and verify(instance, hint).valid:
-            return done(Status.TIME_LIMIT, hint, None, reason="time limit; CP-SAT found no plan, the hint is returned")
-        return done(Status.TIME_LIMIT, reason=f"CP-SAT found no plan ({solver.status_name(st)})")
+            return done(Status.TIME_LIMIT, hint, hist.bound,
+                        reason="time limit; CP-SAT found no plan, the hint is returned")
+        return done(Status.TIME_LIMIT, bound=hist.bound, reason=f"CP-SAT found no plan ({solver.status_name(st)})")
     ivalue = int(round(solver.objective_value))
     # Integer objective: CP-SAT's bound is integral; ceil(x - 1e-6) never rounds it down.
     ibound = math.ceil(solver.best_objective_bound - 1e-6) if st == cp_model.FEASIBLE else ivalue
@@ -416,7 +460,7 @@ def solve_cpsat(
     if hint is not None:
         built2.add_hint(hint)
     solver2 = _solver(left(), threads, seed, linearization)
-    st2 = solver2.solve(built2.m)
+    st2 = solver2.solve(built2.m, _Recorder(built2, hist, best))  # plans only: its bounds are not valid
     info["safe_status"] = solver2.status_name(st2)
     if st2 in (cp_model.OPTIMAL, cp_model.FEASIBLE):
         plan2 = _pad(built2.routes(solver2), instance.n_vehicles)
