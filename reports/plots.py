@@ -43,3 +43,67 @@ def plot_plan(instance: TOPInstance, plan: Plan | None, ax=None, title: str | No
         ax.set_title(title)
     ax.legend(loc="best", fontsize=7, framealpha=0.8)
     return ax
+
+
+def plot_anytime(series: dict, ax=None, title: str | None = None, reference: float | None = None,
+                 colors: dict | None = None, legend: bool = True):
+    """Bound and incumbent against time, one colour per method.
+
+    ``series`` maps a method name to its history ``[[t, incumbent, bound], ...]`` (see
+    :mod:`formulations.history`; None where a value is not known yet). The incumbent is a solid
+    step line, the bound a dashed one, each drawn from its first known value and ending in a
+    marker; ``reference`` (a proven or published optimum) is a thin grey dotted line; ``colors``
+    (method -> colour) keeps colours fixed across panels; ``legend=False`` leaves the legend to
+    the caller (one for a figure of panels). Time is on a symlog axis (linear below
+    1 s). The y range follows the bounds and the final incumbents, so a trivial early incumbent
+    (0) does not flatten the curves; it enters from below.
+    """
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6.5, 4.2))
+    cmap = plt.get_cmap("tab10")
+    lows, highs, t_max, used = [], [], 0.0, {}
+    for k, (method, points) in enumerate(series.items()):
+        c = used[method] = (colors or {}).get(method, cmap(k % 10))
+        for col, style in ((1, "-"), (2, "--")):
+            pts = [(float(p[0]), float(p[col])) for p in points if p[col] is not None]
+            if not pts:
+                continue
+            t, v = zip(*pts)
+            t_max = max(t_max, t[-1])
+            ax.step(t, v, where="post", ls=style, color=c, lw=1.5 if col == 1 else 1.2)
+            ax.plot(t[-1:], v[-1:], marker="o" if col == 1 else "v", color=c, ms=4)
+            (lows if col == 1 else highs).append(v[-1])
+            highs.append(max(v) if col == 2 else v[-1])
+    if reference is not None and np.isfinite(reference):
+        ax.axhline(reference, color="0.5", lw=0.8, ls=":")
+        lows.append(reference)
+        highs.append(reference)
+    if lows or highs:
+        lo, hi = min(lows or highs), max(highs or lows)
+        span = max(hi - lo, 1e-9 + 0.05 * abs(hi))
+        ax.set_ylim(lo - 0.25 * span, hi + 0.05 * span)
+    ax.set_xscale("symlog", linthresh=1.0)
+    ticks = [x for x in (0, 0.5, 1, 2, 5, 10, 20, 60, 120, 300, 600, 1800, 3600) if x <= 1.05 * max(t_max, 1.0)]
+    ax.set_xticks(ticks, [f"{x:g}" for x in ticks])
+    ax.set_xlim(0, max(t_max, 1.0) * 1.05)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("objective")
+    ax.grid(alpha=0.3)
+    if title:
+        ax.set_title(title, fontsize=10)
+    if legend:
+        ax.legend(handles=anytime_legend(used, reference is not None and np.isfinite(reference)), fontsize=6,
+                  loc="best")
+    return ax
+
+
+def anytime_legend(colors: dict, optimum: bool = True) -> list:
+    """Legend handles for :func:`plot_anytime`: one per method (its colour), then the line styles."""
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], color=c, lw=2, label=m) for m, c in colors.items()]
+    handles += [Line2D([], [], color="k", ls="-", label="incumbent"),
+                Line2D([], [], color="k", ls="--", label="bound")]
+    if optimum:
+        handles.append(Line2D([], [], color="0.5", ls=":", label="optimum"))
+    return handles

@@ -3,7 +3,8 @@
 Reads only the results file (and rebuilds one instance through ``formulations`` for the example
 routes plot). Sections: per-method gap table, paper views (coverage against N and against K,
 Fig. 3 and 4; runtime table, Table I; example routes, Fig. 2), gap distributions, time to
-optimality against size for the exact methods, consistency checks, skipped rows.
+optimality against size for the exact methods, bound and incumbent against time (exact methods
+with ``info.history``), consistency checks, skipped rows.
 """
 
 from __future__ import annotations
@@ -256,6 +257,68 @@ def _time_to_optimality(gapped: pd.DataFrame, out: Path, doc: _Doc):
     doc.table(tab.rename_axis("method, size"), "time_to_optimality.csv")
 
 
+ANYTIME_PANELS = 6
+
+
+def _anytime_series(row) -> list | None:
+    """A row's ``info.history``, closed by its final (runtime, objective, bound) if that is later."""
+    info = row.get("info")
+    hist = info.get("history") if isinstance(info, dict) else None
+    if not hist:
+        return None
+    pts = [[float(p[0]), p[1], p[2]] for p in hist]
+    obj = None if pd.isna(row.get("objective")) else float(row["objective"])
+    bnd = None if pd.isna(row.get("bound")) else float(row["bound"])
+    if pd.notna(row.get("runtime_s")) and float(row["runtime_s"]) > pts[-1][0]:
+        pts.append([float(row["runtime_s"]), obj if obj is not None else pts[-1][1],
+                    bnd if bnd is not None else pts[-1][2]])
+    return pts
+
+
+def _anytime(df: pd.DataFrame, inst: pd.DataFrame, out: Path, doc: _Doc):
+    """Bound and incumbent against time of the exact methods, one panel per instance."""
+    from reports.plots import anytime_legend, plot_anytime
+
+    ex = df[df["exact"].astype(bool) & (df["status"] != "error")] if "exact" in df else df.iloc[:0]
+    series: dict = {}
+    for _, r in ex.sort_values(["instance", "method", "seed"]).iterrows():
+        pts = _anytime_series(r)
+        if pts is not None:
+            series.setdefault(r["instance"], {}).setdefault(r["method"], pts)  # first seed only
+    if not series:
+        return
+    pick = sorted(series, key=lambda i: (-len(series[i]), i))[:ANYTIME_PANELS]
+    cols = min(3, len(pick))
+    nrows = int(np.ceil(len(pick) / cols))
+    methods = sorted({m for i in pick for m in series[i]})
+    colors = {m: plt.get_cmap("tab10")(k % 10) for k, m in enumerate(methods)}
+    fig, axes = plt.subplots(nrows, cols, figsize=(5.2 * cols, 3.8 * nrows), squeeze=False)
+    for ax, name in zip(axes.flat, pick):
+        ref = inst["opt"].get(name, np.nan) if "opt" in inst else np.nan
+        plot_anytime(series[name], ax=ax, title=name, reference=None if pd.isna(ref) else float(ref),
+                     colors=colors, legend=False)
+    for ax in list(axes.flat)[len(pick):]:
+        ax.axis("off")
+    handles = anytime_legend(colors, optimum=bool(inst["opt"].reindex(pick).notna().any()))  # one for all panels
+    fig.suptitle("Bound and incumbent against time (exact methods)", fontsize=12)
+    fig.tight_layout(rect=(0, 0.07 if nrows == 1 else 0.04, 1, 1))
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
+    fig.savefig(out / "anytime.png", dpi=110)
+    plt.close(fig)
+    name = "anytime.png"
+    flat = [{"instance": i, "method": m, "t_s": p[0], "incumbent": p[1], "bound": p[2]}
+            for i in pick for m, pts in series[i].items() for p in pts]
+    pd.DataFrame(flat).to_csv(out / "anytime.csv", index=False)
+    doc.h("Bound and incumbent against time (exact methods)")
+    doc.p(f"Per instance ({len(pick)} of {len(series)} with a recorded history: those with the most exact "
+          "methods, then by name), the best verified objective (solid) and the best proven upper bound "
+          "(dashed) of each exact method against its own clock (symlog axis, linear below 1 s); "
+          "the grey dotted line is the proven or published optimum where known. Each curve ends at "
+          "the run's final objective and bound; the first seed of each method is shown.")
+    doc.img(name, "bound and incumbent against time")
+    doc.p("The plotted points are in anytime.csv.")
+
+
 def _parquet(df: pd.DataFrame, path: Path) -> bool:
     flat = df.copy()
     for col in ("routes", "energy", "covered", "info", "source", "versions"):
@@ -319,6 +382,7 @@ def write_report(results_dir: str | Path, out_dir: str | Path) -> str:
     _example_routes(df, out, doc)
     _gap_distributions(gapped, out, doc)
     _time_to_optimality(gapped, out, doc)
+    _anytime(df, inst, out, doc)
     gapped.drop(columns=["routes", "info", "source", "versions", "energy", "covered"], errors="ignore").to_csv(
         out / "runs.csv", index=False)
     parquet = _parquet(df, out / "results.parquet")
