@@ -111,14 +111,14 @@ def base_row(job: dict) -> dict:
         "status": "error", "objective": None, "bound": None, "coverage": None, "covered": None,
         "routes": None, "energy": None, "energy_used": None, "e_max": None, "valid": False,
         "reason": "", "info": {}, "runtime_s": None, "wall_s": None, "time_limit": job["time_limit"],
-        "threads": None, "workers": job.get("workers"), **environment(), "pid": os.getpid(),
+        "threads": None, "workers": job.get("workers"), "cpu_s": None, **environment(), "pid": os.getpid(),
         "finished_at": None,
     }
 
 
 def run_one(job: dict) -> dict:
     """Run one job and return its row. Never raises: any failure is an ``error`` row with a reason."""
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.thread_time()
     row = base_row(job)
     try:
         from benchmarks.registry import result_record, run_method
@@ -141,6 +141,7 @@ def run_one(job: dict) -> dict:
         row["reason"] = f"harness: {type(exc).__name__}: {exc}"
         row["info"] = {"traceback": traceback.format_exc(limit=-3).strip().splitlines()}
     row["wall_s"] = time.perf_counter() - t0
+    row["cpu_s"] = time.thread_time() - c0
     if row["runtime_s"] is None:
         row["runtime_s"] = row["wall_s"]
     row["finished_at"] = _now()

@@ -17,8 +17,10 @@ Row fields (``schema`` 1):
   ``routes``, ``energy`` (per route), ``energy_used`` (sum), ``e_max``, ``valid`` (verifier
   verdict), ``reason``, ``info``;
 - cost: ``runtime_s`` (the method's), ``wall_s`` (the job's, instance build and verification
-  included), ``time_limit``, ``threads`` (what the method reported using, or null), ``workers``
-  (jobs run in parallel);
+  included), ``cpu_s`` (the CPU time of the job's thread over the same span: what a loaded machine
+  does not inflate; it misses threads a method starts itself, and is null in rows of a killed job
+  and in rows written before it was added), ``time_limit``, ``threads`` (what the method reported
+  using, or null), ``workers`` (jobs run in parallel);
 - provenance: ``host``, ``platform``, ``cpu_count``, ``versions`` (package versions), ``pid``,
   ``finished_at`` (UTC ISO time).
 """

@@ -60,6 +60,7 @@ def test_small_suite_end_to_end_cli(tmp_path, capsys):
             assert r["objective"] == pytest.approx(r["coverage"] * r["M"] * r["K"])
         assert r["energy_used"] <= r["e_max"] * r["n_vehicles"] * (1 + 1e-9)
         assert r["versions"]["numpy"] and r["host"] and r["schema"] == 1 and r["workers"] == 2
+        assert 0 < r["cpu_s"] <= r["wall_s"] + 0.05  # the job thread's CPU time, within its wall time
     sar = [r for r in rows if r["kind"] == "sar"]
     assert {(r["N"], r["instance_seed"]) for r in sar} == {(2, 0), (2, 1), (3, 0), (3, 1)}
     assert pd.read_json(out / "results.jsonl", lines=True).shape[0] == len(rows)  # pandas reads it natively
