@@ -76,8 +76,9 @@ class _Stats:
 
 class BranchAndPrice:
     def __init__(self, instance: TOPInstance, *, time_limit: float | None, ng_size: int = 8,
-                 initial_routes=None, bidirectional: bool | None = None):
+                 initial_routes=None, bidirectional: bool | None = None, ng_columns: bool = True):
         self.bidirectional = bidirectional
+        self.ng_columns = ng_columns
         self.inst = instance
         self.t0 = time.perf_counter()
         limit = float(time_limit) if time_limit is not None else math.inf
@@ -161,6 +162,8 @@ class BranchAndPrice:
         return cost, cheapest_return(cost), allowed
 
     def _price(self, cost, ret, prof, allowed, *, heuristic, y0, max_labels=None):
+        """Pricing; ``y0`` is the threshold a path's reduced prize must beat (the vehicle dual,
+        or more for a targeted exact call)."""
         t = time.perf_counter()
         if max_labels is None:
             max_labels = 200_000 if heuristic else 2_000_000
@@ -194,6 +197,20 @@ class BranchAndPrice:
         self.bidirectional = bool(bi.exact) and t_bi < 0.8 * t_uni
         return uni
 
+    def _slack(self, dual_value: float) -> float:
+        """How much the best route's reduced prize may exceed the vehicle dual while
+        dual_value + N·excess stays below the next value that matters (integer prizes only)."""
+        if not self.integral:
+            return 0.0
+        target = math.floor(dual_value + 1e-6) + 1.0
+        if self.incumbent is not None:
+            target = max(target, self.incumbent_value + 1.0)
+        # reported best >= y0 + slack + TOL, so keep N·TOL and the floor's 1e-6 below target
+        return max(0.0, (target - dual_value - 2e-6) / self.N - 2 * TOL)
+
+    def _columns(self, res):
+        return list(res.routes) + (list(res.ng_routes) if self.ng_columns else [])
+
     def column_generation(self, state: NodeState, bound: float):
         """Solve one node's LP by column generation. Returns (bound, x, x_art, converged)."""
         m = self.master
@@ -215,21 +232,26 @@ class BranchAndPrice:
                 allowed &= prof > 1e-12
             y0 = float(y[0])
             res = self._price(cost, ret, prof, allowed, heuristic=True, y0=y0)
-            if res.routes and m.add_routes(res.routes):
+            if m.add_routes(self._columns(res)):
                 continue
             if self._time_left() <= 0:
                 return bound, x, xa, False
-            res = self._exact_price(cost, ret, prof, allowed, y0)
+            # Targeted exact pricing: with integer prizes the node's bound only matters floored,
+            # so a path must beat y0 + slack, where slack is what the reduced prize of N routes
+            # may add to the dual value without reaching the next integer (or incumbent + 1).
+            # If none does, floor(bound) is settled: the node is pruned or branched on now.
+            gain = y0 + self._slack(m.lagrangian_bound(y, y0))
+            res = self._exact_price(cost, ret, prof, allowed, gain)
             self.stats.exact_pricings += 1
             if res.exact:
                 bound = min(bound, m.lagrangian_bound(y, res.best))
                 if state.depth == 0:
                     self._log(bound)
-                elif self._prunable(bound):
-                    return bound, x, xa, True  # pruned before the LP converged
-            if res.routes and m.add_routes(res.routes):
+                if self._prunable(bound):
+                    return bound, x, xa, True  # pruned (at the root: proven) before convergence
+            if m.add_routes(self._columns(res)):
                 continue
-            if res.best - y0 > TOL and res.cycles:
+            if res.best - gain > TOL and res.cycles:
                 for cyc in res.cycles:  # cycle u ... u: remember u at every node of the cycle
                     u = cyc[0]
                     for w in cyc[1:-1]:
@@ -316,13 +338,16 @@ class BranchAndPrice:
         if open_bounds:
             open_bound = max(self._floor(b) for b in open_bounds)
             bound = max(inc, open_bound)
+            # every open node is prunable: the incumbent is optimal
+            proven = self.incumbent is not None and not unresolved and open_bound <= inc + TOL
         else:
             bound = inc
         return proven, bound
 
 
 def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
-             initial_routes=None, ng_size: int = 8, bidirectional: bool | None = None) -> Result:
+             initial_routes=None, ng_size: int = 8, bidirectional: bool | None = None,
+             ng_columns: bool = True) -> Result:
     """Branch-and-price: proven optimum, or the best plan and a certified bound at the limit.
 
     ``initial_routes`` (node ids, e.g. a heuristic plan's routes) are added as starting columns
@@ -336,7 +361,8 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
     if reason is not None:
         return Result("bp", Status.INFEASIBLE, reason=reason, runtime_s=time.perf_counter() - t0)
     bp = BranchAndPrice(instance, time_limit=time_limit, ng_size=ng_size,
-                        initial_routes=initial_routes, bidirectional=bidirectional)
+                        initial_routes=initial_routes, bidirectional=bidirectional,
+                        ng_columns=ng_columns)
     proven, bound = bp.run()
     st = bp.stats
     info = {

@@ -63,9 +63,10 @@ class Master:
         self.route_prize: list[float] = []
         self.seen: set[tuple[int, ...]] = set()
         cap = 256
-        self._visit = np.zeros((cap, self.V + 2), dtype=bool)
+        self._visit = np.zeros((cap, self.V + 2), dtype=np.int16)  # visits of each point
         self._succ = np.full((cap, self.V + 2), -1, dtype=np.int32)  # successor of each point
         self._pred = np.full((cap, self.V + 2), -1, dtype=np.int32)
+        self.repeated: list[int] = []  # routes (ng-routes) that visit some point twice
         self.col_ub = np.zeros(0)
         self.cur_lo = self.row_lo.copy()
 
@@ -75,7 +76,11 @@ class Master:
         return len(self.routes)
 
     def add_routes(self, routes) -> int:
-        """Add new elementary routes (tuples of solver points); return how many were new."""
+        """Add new routes (tuples of solver points); return how many were new.
+
+        A route may visit a point more than once (an ng-route): its coefficients count the
+        visits, so it can never be part of an integer solution (a node row is <= 1) but it keeps
+        the LP a relaxation of the elementary one that the ng-route pricing bounds exactly."""
         new = [tuple(int(p) for p in r) for r in routes if r and tuple(r) not in self.seen]
         new = list(dict.fromkeys(new))
         if not new:
@@ -84,7 +89,7 @@ class Master:
         need = k0 + len(new)
         if need > self._visit.shape[0]:
             cap = max(need, 2 * self._visit.shape[0])
-            for name, fill in (("_visit", False), ("_succ", -1), ("_pred", -1)):
+            for name, fill in (("_visit", 0), ("_succ", -1), ("_pred", -1)):
                 old = getattr(self, name)
                 arr = np.full((cap, self.V + 2), fill, dtype=old.dtype)
                 arr[: old.shape[0]] = old
@@ -98,14 +103,16 @@ class Master:
             pts = np.asarray(r, dtype=np.int64)
             prize = float(self.prizes[pts - 1].sum())
             self.route_prize.append(prize)
-            self._visit[k, pts] = True
+            np.add.at(self._visit[k], pts, 1)
+            if len(set(r)) < len(r):
+                self.repeated.append(k)
             full = [0, *r, end]
             for a, b in zip(full, full[1:]):
                 self._succ[k, a] = b
                 self._pred[k, b] = a
             coef: dict[int, float] = {0: 1.0}
             for p in r:
-                coef[p] = 1.0
+                coef[p] = coef.get(p, 0.0) + 1.0
                 g = self.group_of_point[p]
                 if g >= 0:
                     row = 1 + self.V + g
@@ -129,15 +136,25 @@ class Master:
         visit, succ, pred = self._visit[:k], self._succ[:k], self._pred[:k]
         bad = np.zeros(k, dtype=bool)
         for p in state.forbidden_nodes:
-            bad |= visit[:, p]
+            bad |= visit[:, p] > 0
         for a, b in state.forbidden_arcs:
             bad |= succ[:, a] == b
         end = self.V + 1
         for a, b in state.forced_arcs:
             if a != 0:
-                bad |= visit[:, a] & (succ[:, a] != b)
+                bad |= (visit[:, a] > 0) & (succ[:, a] != b)
             if b != end:
-                bad |= visit[:, b] & (pred[:, b] != a)
+                bad |= (visit[:, b] > 0) & (pred[:, b] != a)
+        # succ/pred keep only the last visit of a repeated point: check those routes arc by arc
+        for r in self.repeated:
+            full = [0, *self.routes[r], end]
+            arcs = list(zip(full, full[1:]))
+            out = any(a == p for p in state.forbidden_nodes for a in self.routes[r])
+            out = out or any(arc in state.forbidden_arcs for arc in arcs)
+            for fa, fb in state.forced_arcs:
+                out = out or any((a == fa and fa != 0 and b != fb) or (b == fb and fb != end and a != fa)
+                                 for a, b in arcs)
+            bad[r] = out
         return bad
 
     def apply(self, state) -> None:
@@ -223,6 +240,7 @@ class Master:
         st = (starts[self.n_art : self.n_art + k] - a0).astype(np.int32)
         nnz = int(starts[self.n_art + k] - a0)
         ub = np.ones(k) if allowed is None else np.where(allowed, 1.0, 0.0)
+        ub[self.repeated] = 0.0  # never in an integer solution
         h.addCols(k, np.asarray(self.route_prize), np.zeros(k), ub, nnz, st,
                   index[a0 : a0 + nnz], value[a0 : a0 + nnz])
         h.changeColsIntegrality(k, np.arange(k, dtype=np.int32),

@@ -53,14 +53,74 @@ def _grow(arr, size):
 
 
 @njit(cache=True)
-def _completion(mask, room, order, profit, cin):
-    """Fractional-knapsack bound on the prize still collectable with ``room`` energy: each
-    further node w (not remembered in ``mask``) costs at least ``cin[w]``; ``order`` lists the
-    positive-prize nodes by prize/cin, best first."""
-    ub = 0.0
+def _heap_push(key, val, n, k, v):
+    """Push (k, v) on the binary min-heap key[:n]/val[:n]; return the new size."""
+    i = n
+    while i > 0:
+        parent = (i - 1) >> 1
+        if key[parent] <= k:
+            break
+        key[i] = key[parent]
+        val[i] = val[parent]
+        i = parent
+    key[i] = k
+    val[i] = v
+    return n + 1
+
+
+@njit(cache=True)
+def _heap_pop(key, val, n):
+    """Remove the minimum (key[0], val[0]) of the heap key[:n]; return the new size."""
+    n -= 1
+    if n == 0:
+        return 0
+    k = key[n]
+    v = val[n]
+    i = 0
+    while True:
+        c = 2 * i + 1
+        if c >= n:
+            break
+        if c + 1 < n and key[c + 1] < key[c]:
+            c += 1
+        if key[c] >= k:
+            break
+        key[i] = key[c]
+        val[i] = val[c]
+        i = c
+    key[i] = k
+    val[i] = v
+    return n
+
+
+@njit(cache=True)
+def _completion(mask, v, room, need, order, profit, cin, reach, lastord, cend):
+    """Upper bound on the prize an elementary suffix can still add to a label at ``v`` with
+    ``room`` energy left (budget minus the label's energy).
+
+    A further node u must fit: ``reach[v, u]`` (cheapest energy v -> ... -> u -> end) <= room.
+    Among the fitting nodes not remembered in ``mask``, the suffix ends with one arc u -> end
+    (at least the smallest ``cend`` of a fitting node: ``lastord`` lists the allowed nodes by
+    cend) and each of its nodes w costs at least ``cin[w]`` (its cheapest incoming arc), so a
+    fractional knapsack over ``order`` (positive-prize nodes by prize/cin) bounds the prize.
+    The knapsack stops as soon as it exceeds ``need`` (the caller only compares against it)."""
     if room <= 0.0:
         return 0.0
+    last = np.inf
+    for u in lastord:
+        if reach[v, u] <= room and not (mask[u >> 6] & (np.uint64(1) << np.uint64(u & 63))):
+            last = cend[u]
+            break
+    if last == np.inf:
+        return 0.0  # no further node fits
+    room0 = room
+    room -= last
+    if room < 0.0:
+        room = 0.0
+    ub = 0.0
     for w in order:
+        if reach[v, w] > room0:
+            continue
         if mask[w >> 6] & (np.uint64(1) << np.uint64(w & 63)):
             continue
         c = cin[w]
@@ -68,6 +128,8 @@ def _completion(mask, room, order, profit, cin):
             return np.inf
         if c <= room:
             ub += profit[w]
+            if ub > need:
+                return ub
             room -= c
         else:
             return ub + profit[w] * room / c
@@ -75,13 +137,15 @@ def _completion(mask, room, order, profit, cin):
 
 
 @njit(cache=True)
-def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, threshold,
-           deadline, last_leg, half):
+def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
+           lastord, cend, threshold, deadline, half):
     """Labelling from node 0 to node n-1.
 
     Returns (count, node, pred, energy, prize, mask, alive, hit_cap, threshold). Labels whose
     prize plus the completion bound cannot exceed ``threshold`` are not stored; only labels with
-    energy <= ``half`` are extended (``half`` = budget for a one-way search).
+    energy <= ``half`` are extended (``half`` = budget for a one-way search). Labels are kept in
+    creation order (global arrays, for the paths) and, for the dominance tests, in contiguous
+    per-node buckets (energy, prize, mask, label id) so that the scans stay in cache.
     """
     n = cost.shape[0]
     end = n - 1
@@ -92,31 +156,39 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
     en = np.empty(cap, np.float64)
     pr = np.empty(cap, np.float64)
     alive = np.empty(cap, np.bool_)
-    nxt = np.empty(cap, np.int32)
     mask = np.zeros((cap, W), np.uint64)
-    head = np.full(n, -1, np.int32)
+    # per-node buckets of the alive labels
+    bcnt = np.zeros(n, np.int64)
+    ben = [np.empty(16, np.float64) for _ in range(n)]
+    bpr = [np.empty(16, np.float64) for _ in range(n)]
+    bid = [np.empty(16, np.int32) for _ in range(n)]
+    bmask = [np.zeros((16, W), np.uint64) for _ in range(n)]
     node[0] = 0
     pred[0] = -1
     en[0] = 0.0
     pr[0] = 0.0
     alive[0] = True
-    nxt[0] = -1
-    head[0] = 0
     count = 1
     hit = False
-    qi = 0
+    # labels are extended in order of energy (a binary heap): when a label is extended, every
+    # label of lower energy already exists, so it is never dominated after being extended
+    hkey = np.empty(cap, np.float64)
+    hval = np.empty(cap, np.int32)
+    hkey[0] = 0.0
+    hval[0] = 0
+    hn = 1
     newmask = np.zeros(W, np.uint64)
-    while qi < count:
+    while hn > 0:
+        qi = hval[0]
+        hn = _heap_pop(hkey, hval, hn)
         if not alive[qi]:
-            qi += 1
             continue
         v = node[qi]
         if en[qi] > half:
-            qi += 1
             continue
         # the threshold may have risen since this label was stored
-        if pr[qi] + _completion(mask[qi], budget - en[qi] - last_leg, order, profit, cin) <= threshold:
-            qi += 1
+        if pr[qi] + _completion(mask[qi], v, budget - en[qi], threshold - pr[qi], order, profit,
+                                cin, reach, lastord, cend) <= threshold:
             continue
         for w in range(1, end):
             if not allowed[w]:
@@ -133,42 +205,48 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             for k in range(W):
                 newmask[k] = mask[qi, k] & ng[w, k]
             newmask[wd] |= wb
-            if p2 + _completion(newmask, budget - e2 - last_leg, order, profit, cin) <= threshold:
+            if p2 + _completion(newmask, w, budget - e2, threshold - p2, order, profit, cin, reach,
+                                lastord, cend) <= threshold:
                 continue
             # dominance against the labels at w
             dominated = False
-            j = head[w]
-            prev = -1
-            while j >= 0:
-                if not alive[j]:  # unlink labels dominated earlier
-                    j = nxt[j]
-                    if prev < 0:
-                        head[w] = j
-                    else:
-                        nxt[prev] = j
-                    continue
-                if alive[j]:
-                    if en[j] <= e2 + EPS and pr[j] >= p2 - EPS:
-                        sub = True
-                        if not heuristic:
-                            for k in range(W):
-                                if mask[j, k] & ~newmask[k]:
-                                    sub = False
-                                    break
-                        if sub:
-                            dominated = True
-                            break
-                    if e2 <= en[j] + EPS and p2 >= pr[j] - EPS:
-                        sub = True
-                        if not heuristic:
-                            for k in range(W):
-                                if newmask[k] & ~mask[j, k]:
-                                    sub = False
-                                    break
-                        if sub:
-                            alive[j] = False
-                prev = j
-                j = nxt[j]
+            we = ben[w]
+            wp = bpr[w]
+            wi = bid[w]
+            wm = bmask[w]
+            cw = bcnt[w]
+            j = 0
+            while j < cw:
+                ej = we[j]
+                pj = wp[j]
+                if ej <= e2 + EPS and pj >= p2 - EPS:
+                    sub = True
+                    if not heuristic:
+                        for k in range(W):
+                            if wm[j, k] & ~newmask[k]:
+                                sub = False
+                                break
+                    if sub:
+                        dominated = True
+                        break
+                if e2 <= ej + EPS and p2 >= pj - EPS:
+                    sub = True
+                    if not heuristic:
+                        for k in range(W):
+                            if newmask[k] & ~wm[j, k]:
+                                sub = False
+                                break
+                    if sub:
+                        alive[wi[j]] = False
+                        cw -= 1  # move the bucket's last label into slot j, examine it next
+                        we[j] = we[cw]
+                        wp[j] = wp[cw]
+                        wi[j] = wi[cw]
+                        for k in range(W):
+                            wm[j, k] = wm[cw, k]
+                        continue
+                j += 1
+            bcnt[w] = cw
             if dominated:
                 continue
             if count == max_labels:
@@ -187,8 +265,9 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
                 en = _grow(en, cap)
                 pr = _grow(pr, cap)
                 alive = _grow(alive, cap)
-                nxt = _grow(nxt, cap)
                 mask = _grow(mask, cap)
+                hkey = _grow(hkey, cap)
+                hval = _grow(hval, cap)
             node[count] = w
             pred[count] = qi
             en[count] = e2
@@ -198,12 +277,26 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             alive[count] = True
             for k in range(W):
                 mask[count, k] = newmask[k]
-            nxt[count] = head[w]
-            head[w] = count
+            if cw == we.shape[0]:
+                size = 2 * cw
+                we = _grow(we, size)
+                wp = _grow(wp, size)
+                wi = _grow(wi, size)
+                wm = _grow(wm, size)
+                ben[w] = we
+                bpr[w] = wp
+                bid[w] = wi
+                bmask[w] = wm
+            we[cw] = e2
+            wp[cw] = p2
+            wi[cw] = count
+            for k in range(W):
+                wm[cw, k] = newmask[k]
+            bcnt[w] = cw + 1
+            hn = _heap_push(hkey, hval, hn, e2, count)
             count += 1
         if hit:
             break
-        qi += 1
     return (count, node[:count], pred[:count], en[:count], pr[:count], mask[:count],
             alive[:count], hit, threshold)
 
@@ -300,18 +393,21 @@ class PricingResult:
     that value is proven (exact search over a relaxation of the elementary routes), and the
     improving elementary routes found (solver indices, without start and end)."""
 
-    __slots__ = ("best", "exact", "routes", "cycles", "n_labels")
+    __slots__ = ("best", "exact", "routes", "cycles", "n_labels", "ng_routes")
 
-    def __init__(self, best, exact, routes, cycles, n_labels):
+    def __init__(self, best, exact, routes, cycles, n_labels, ng_routes=()):
         self.best = best
         self.exact = exact
         self.routes = routes
         self.cycles = cycles
         self.n_labels = n_labels
+        self.ng_routes = ng_routes
 
 
 def _prepare(cost, ret, profit, allowed):
-    """Completion-bound data: order of positive nodes by prize/cin, cin, and the last-leg energy."""
+    """Completion-bound data (see :func:`_completion`): positive nodes by prize/cin, cin, the
+    reach matrix (cheapest energy v -> ... -> u -> end through allowed nodes), the allowed
+    nodes by their arc into the end, and those arcs."""
     n = cost.shape[0]
     end = n - 1
     pts = np.arange(n)
@@ -323,10 +419,18 @@ def _prepare(cost, ret, profit, allowed):
     good = np.flatnonzero(inner & (profit > 0))
     ratio = np.where(cin[good] > 0, profit[good] / np.maximum(cin[good], 1e-300), np.inf)
     order = good[np.argsort(-ratio, kind="stable")].astype(np.int64)
-    # Any further node is followed, eventually, by one arc into the end that no cin[] counts.
-    last_leg = float(cost[inner, end].min()) if inner.any() else 0.0
-    last_leg = min(max(last_leg, 0.0), float(ret[inner].min()) if inner.any() else 0.0)
-    return order, cin, last_leg
+    # shortest paths through allowed nodes only (Floyd-Warshall; no triangle inequality needed)
+    sp = np.where(np.isfinite(cost), cost, np.inf).astype(np.float64)
+    np.fill_diagonal(sp, 0.0)
+    for k in np.flatnonzero(inner):
+        sp = np.minimum(sp, sp[:, k : k + 1] + sp[k : k + 1, :])
+    reach = sp + sp[:, end][None, :]
+    fin = np.isfinite(reach)  # rounding slack below: never prune a node that fits
+    reach = np.ascontiguousarray(np.where(fin, reach - 1e-9 * (1.0 + np.abs(np.where(fin, reach, 0.0))), np.inf))
+    cend = np.ascontiguousarray(cost[:, end], dtype=np.float64)
+    inner_pts = np.flatnonzero(inner)
+    lastord = inner_pts[np.argsort(cend[inner_pts], kind="stable")].astype(np.int64)
+    return order, cin, reach, lastord, cend
 
 
 def _chain(node, pred, j):
@@ -357,10 +461,10 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     n = cost.shape[0]
     end = n - 1
     half = budget / 2.0 if bidirectional else budget
-    order, cin, last_leg = _prepare(cost, ret, profit, allowed)
+    order, cin, reach, lastord, cend = _prepare(cost, ret, profit, allowed)
     count, node, pred, en, pr, fmask, falive, hit, thr = _label(
-        cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin,
-        float(min_gain), float(deadline), last_leg, half,
+        cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
+        lastord, cend, float(min_gain), float(deadline), half,
     )
     total = int(count)
     found = []  # (value, path)
@@ -375,10 +479,10 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
         ret_b = cheapest_return(cost_b)
         allowed_b = allowed[perm]
         profit_b = np.ascontiguousarray(profit[perm])
-        order_b, cin_b, last_b = _prepare(cost_b, ret_b, profit_b, allowed_b)
+        order_b, cin_b, reach_b, lastord_b, cend_b = _prepare(cost_b, ret_b, profit_b, allowed_b)
         bcount, bnode, bpred, ben, bpr, bmask, balive, bhit, thr = _label(
             cost_b, ret_b, profit_b, budget, ng, allowed_b, heuristic, max_labels, order_b, cin_b,
-            float(thr), float(deadline), last_b, half,
+            reach_b, lastord_b, cend_b, float(thr), float(deadline), half,
         )
         total += int(bcount)
         hit = hit or bhit
@@ -403,22 +507,26 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     # Paths pruned by the completion bound are worth at most min_gain; the empty route is 0.
     best = max(best, 0.0, float(min_gain))
     found.sort(key=lambda t: -t[0])
-    routes, cycles, seen = [], [], set()
+    routes, cycles, ng_routes, seen = [], [], [], set()
     for _, path in found:
+        key = tuple(path)
+        if key in seen:
+            continue
+        seen.add(key)
         if len(set(path)) == len(path):
-            key = tuple(path)
-            if key not in seen:
-                seen.add(key)
-                routes.append(key)
-                if len(routes) >= n_cols:
-                    break
-        elif len(cycles) < 20:
-            last = {}
-            for pos, u in enumerate(path):
-                if u in last:
-                    cycles.append(tuple(path[last[u] : pos + 1]))
-                last[u] = pos
-    return PricingResult(best, (not hit) and (not heuristic), routes, cycles, total)
+            routes.append(key)
+            if len(routes) >= n_cols:
+                break
+        else:
+            if len(ng_routes) < n_cols:
+                ng_routes.append(key)
+            if len(cycles) < 20:
+                last = {}
+                for pos, u in enumerate(path):
+                    if u in last:
+                        cycles.append(tuple(path[last[u] : pos + 1]))
+                    last[u] = pos
+    return PricingResult(best, (not hit) and (not heuristic), routes, cycles, total, ng_routes)
 
 
 _WARM = False
