@@ -76,12 +76,15 @@ class _Stats:
 
 class BranchAndPrice:
     def __init__(self, instance: TOPInstance, *, time_limit: float | None, ng_size: int = 8,
-                 initial_routes=None, bidirectional: bool | None = None, ng_columns: bool = True):
+                 initial_routes=None, bidirectional: bool | None = None, ng_columns: bool = True,
+                 ng_cap: int = 16):
         self.bidirectional = bidirectional
         self.ng_columns = ng_columns
+        self.ng_cap = ng_cap
         self.inst = instance
         self.t0 = time.perf_counter()
         limit = float(time_limit) if time_limit is not None else math.inf
+        self.dive_limit = 0.1 * limit if math.isfinite(limit) else 30.0
         self.hard_deadline = self.t0 + limit
         self.reserve = min(5.0, 0.1 * limit)  # kept for a last MILP over the generated routes
         self.deadline = self.hard_deadline - self.reserve
@@ -197,6 +200,33 @@ class BranchAndPrice:
         self.bidirectional = bool(bi.exact) and t_bi < 0.8 * t_uni
         return uni
 
+    def _grow_ng_from_lp(self, x) -> bool:
+        """Dynamic ng sets: for every repeated route in the LP solution, remember the repeated
+        point along its cycle (ng sets capped at ``ng_cap``), exclude the routes that stop being
+        ng-routes, and report whether anything changed (the LP is then re-solved)."""
+        m = self.master
+        grown = False
+        for r in m.repeated:
+            if x[r] <= TOL or r in m.dead:
+                continue
+            path = m.routes[r]
+            last = {}
+            for pos, u in enumerate(path):
+                if u in last:
+                    for w in path[last[u] + 1 : pos]:
+                        if not (self.ng[w, u >> 6] >> np.uint64(u & 63)) & np.uint64(1) and \
+                                self._ng_size(w) < self.ng_cap:
+                            add_to_ng(self.ng, w, u)
+                            grown = True
+                last[u] = pos
+        if grown:
+            self.stats.ng_growths += 1
+            m.kill_non_ng(self.ng)
+        return grown
+
+    def _ng_size(self, w: int) -> int:
+        return int(sum(bin(int(word)).count("1") for word in self.ng[w]))
+
     def _slack(self, dual_value: float) -> float:
         """How much the best route's reduced prize may exceed the vehicle dual while
         dual_value + N·excess stays below the next value that matters (integer prizes only)."""
@@ -260,7 +290,44 @@ class BranchAndPrice:
                 continue
             if not res.exact:
                 return bound, x, xa, False
+            if self._grow_ng_from_lp(x):
+                m.apply(state)
+                continue
             return bound, x, xa, True
+
+    # -- primal heuristic ------------------------------------------------------------------
+    def dive(self, limit: float) -> None:
+        """Diving: fix the route of largest LP value (its nodes and arcs forced), re-solve the
+        LP with heuristic pricing only, repeat until the LP solution is integral. Proves
+        nothing; feeds incumbents and columns (the routes that fit together) to the MILP."""
+        m = self.master
+        stop = min(self.deadline, time.perf_counter() + limit)
+        state = NodeState()
+        fixed: set[int] = set()
+        while time.perf_counter() < stop:
+            m.apply(state)
+            cost, ret, allowed = self._node_graph(state)
+            for _ in range(200):
+                value, x, xa, y = m.solve()
+                if time.perf_counter() >= stop:
+                    break
+                res = self._price(cost, ret, m.point_profit(y), allowed, heuristic=True,
+                                  y0=float(y[0]))
+                if not m.add_routes(res.routes):
+                    break
+            if xa.max() > TOL:
+                break  # the fixings cannot be completed (as far as heuristic pricing sees)
+            pos = np.flatnonzero(x > TOL)
+            if np.all(np.abs(x[pos] - np.round(x[pos])) <= TOL):
+                self._offer([m.routes[r] for r in np.flatnonzero(x > 0.5)])
+                break
+            cand = [r for r in pos if r not in fixed and r not in m.repeated]
+            if not cand:
+                break
+            r = max(cand, key=lambda k: x[k])
+            fixed.add(r)
+            full = [0, *m.routes[r], self.V + 1]
+            state = state.child(forced_nodes=m.routes[r], forced_arcs=list(zip(full, full[1:])))
 
     # -- branch and bound ------------------------------------------------------------------
     def _branch(self, state: NodeState, x: np.ndarray):
@@ -307,6 +374,10 @@ class BranchAndPrice:
             if state.depth == 0:
                 self.stats.root_bound = bound if math.isfinite(bound) else None
                 self.stats.root_s = time.perf_counter() - self.t0
+                if converged and not self._prunable(bound) and self._time_left() > 0:
+                    self.dive(min(self.dive_limit, 0.5 * self._time_left()))
+                    self.master.apply(state)  # back to the root, with the dive's columns
+                    _, x, xa, _ = self.master.solve()
                 if self._time_left() > 0:
                     self._run_milp(min(10.0, 0.25 * self._time_left()))
                     last_milp_cols = self.master.n_routes
@@ -347,7 +418,7 @@ class BranchAndPrice:
 
 def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
              initial_routes=None, ng_size: int = 8, bidirectional: bool | None = None,
-             ng_columns: bool = True) -> Result:
+             ng_columns: bool = True, ng_cap: int = 16) -> Result:
     """Branch-and-price: proven optimum, or the best plan and a certified bound at the limit.
 
     ``initial_routes`` (node ids, e.g. a heuristic plan's routes) are added as starting columns
@@ -362,7 +433,7 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
         return Result("bp", Status.INFEASIBLE, reason=reason, runtime_s=time.perf_counter() - t0)
     bp = BranchAndPrice(instance, time_limit=time_limit, ng_size=ng_size,
                         initial_routes=initial_routes, bidirectional=bidirectional,
-                        ng_columns=ng_columns)
+                        ng_columns=ng_columns, ng_cap=ng_cap)
     proven, bound = bp.run()
     st = bp.stats
     info = {

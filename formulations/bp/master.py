@@ -67,6 +67,7 @@ class Master:
         self._succ = np.full((cap, self.V + 2), -1, dtype=np.int32)  # successor of each point
         self._pred = np.full((cap, self.V + 2), -1, dtype=np.int32)
         self.repeated: list[int] = []  # routes (ng-routes) that visit some point twice
+        self.dead: set[int] = set()  # repeated routes that are no ng-routes of the grown ng sets
         self.col_ub = np.zeros(0)
         self.cur_lo = self.row_lo.copy()
 
@@ -147,6 +148,9 @@ class Master:
                 bad |= (visit[:, b] > 0) & (pred[:, b] != a)
         # succ/pred keep only the last visit of a repeated point: check those routes arc by arc
         for r in self.repeated:
+            if r in self.dead:
+                bad[r] = True
+                continue
             full = [0, *self.routes[r], end]
             arcs = list(zip(full, full[1:]))
             out = any(a == p for p in state.forbidden_nodes for a in self.routes[r])
@@ -156,6 +160,22 @@ class Master:
                                  for a, b in arcs)
             bad[r] = out
         return bad
+
+    def kill_non_ng(self, ng: np.ndarray) -> int:
+        """Exclude the repeated routes that are not ng-routes for the ng sets ``ng`` (bitsets);
+        return how many. Only elementary routes matter for the bound, so this is always valid."""
+        n = 0
+        for r in self.repeated:
+            if r in self.dead:
+                continue
+            mem: set[int] = set()
+            for w in self.routes[r]:
+                if w in mem:
+                    self.dead.add(r)
+                    n += 1
+                    break
+                mem = {u for u in mem if ng[w, u >> 6] >> np.uint64(u & 63) & np.uint64(1)} | {w}
+        return n
 
     def apply(self, state) -> None:
         """Set column and row bounds for a branch-and-bound node."""

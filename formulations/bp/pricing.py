@@ -228,6 +228,15 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
                                 break
                     if sub:
                         dominated = True
+                        if j > 0:  # move the dominator forward: it is likely to dominate again
+                            h = j >> 1
+                            we[j], we[h] = we[h], we[j]
+                            wp[j], wp[h] = wp[h], wp[j]
+                            wi[j], wi[h] = wi[h], wi[j]
+                            for k in range(W):
+                                t = wm[j, k]
+                                wm[j, k] = wm[h, k]
+                                wm[h, k] = t
                         break
                 if e2 <= ej + EPS and p2 >= pj - EPS:
                     sub = True
