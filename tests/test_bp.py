@@ -172,3 +172,137 @@ def test_sar_infeasible_when_targets_do_not_fit():
     assert precheck(inst) is None and brute_force(inst) is None
     res, rep = run_method("bp", inst, time_limit=30)
     assert res.status == Status.INFEASIBLE
+
+
+# -- the pieces added for the M = 20 SAR instances (issue 6) -----------------------------------
+
+def _tiny_pricing(seed: int, n_nodes: int = 7):
+    """A random pricing problem: Euclidean arcs with an image cost, reduced prizes of both signs."""
+    from formulations.bp.pricing import cheapest_return
+
+    rng = np.random.default_rng(seed)
+    inst = TOPInstance(coords=rng.uniform(0, 10, size=(n_nodes, 2)), prizes=np.ones(n_nodes),
+                       start=np.zeros(2), end=np.zeros(2) if seed % 2 else np.array([10.0, 0.0]),
+                       budget=float(rng.uniform(18, 30)), n_vehicles=1, e_fly=1.0, e_image=1.5)
+    cost = inst.cost_matrix().copy()
+    profit = np.zeros(n_nodes + 2)
+    profit[1:-1] = rng.uniform(-0.5, 2.0, n_nodes)
+    return cost, cheapest_return(cost), profit, inst.budget * (1 + 1e-9)
+
+
+def _brute_paths(cost, profit, budget):
+    """Every elementary path start -> nodes -> end within the budget: (prize, path)."""
+    n = cost.shape[0]
+    out = []
+    for k in range(1, n - 1):
+        for perm in itertools.permutations(range(1, n - 1), k):
+            full = (0, *perm, n - 1)
+            if sum(cost[a, b] for a, b in zip(full, full[1:])) <= budget:
+                out.append((float(profit[list(perm)].sum()), perm))
+    return out
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("bidirectional", [False, True])
+def test_exact_pricing_matches_enumeration(seed, bidirectional):
+    """Elementary labelling (heap order, buckets, reach-filtered completion bound): its best value
+    is the best elementary path's prize, its routes are real improving paths; ng-8 labelling and the
+    heuristic bracket it (ng value >= elementary best >= any heuristic route)."""
+    from formulations.bp.pricing import full_ng, nearest_ng, price
+
+    cost, ret, profit, budget = _tiny_pricing(seed)
+    paths = _brute_paths(cost, profit, budget)
+    best = max(p for p, _ in paths)
+    gain = 0.3 * best
+    allowed = np.ones(cost.shape[0], dtype=bool)
+    kw = dict(max_labels=1_000_000, n_cols=50, min_gain=gain)
+    ex = price(cost, ret, profit, budget, full_ng(cost.shape[0]), allowed, heuristic=False,
+               bidirectional=bidirectional, **kw)
+    assert ex.exact and ex.best == pytest.approx(max(best, gain))
+    value = {path: p for p, path in paths}
+    for r in ex.routes:
+        assert r in value and value[r] > gain
+    assert ex.routes[0] in value and value[ex.routes[0]] == pytest.approx(best)
+    ng = price(cost, ret, profit, budget, nearest_ng(cost, 2), allowed, heuristic=False,
+               bidirectional=bidirectional, **kw)
+    assert ng.exact and ng.best >= best - 1e-9
+    heur = price(cost, ret, profit, budget, full_ng(cost.shape[0]), allowed, heuristic=True, **kw)
+    assert all(r in value and value[r] <= best + 1e-9 for r in heur.routes)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_completion_bound_covers_every_suffix(seed):
+    """_completion never undercuts the best elementary suffix of a path prefix (enumerated)."""
+    from formulations.bp.pricing import _completion, _prepare, n_words
+
+    cost, ret, profit, budget = _tiny_pricing(seed)
+    n = cost.shape[0]
+    order, cin, reach, lastord, cend = _prepare(cost, ret, profit, np.ones(n, dtype=bool))
+    paths = _brute_paths(cost, profit, budget)
+    for _, path in paths[:: max(1, len(paths) // 300)]:
+        for cut in range(1, len(path) + 1):
+            pre, v = path[:cut], path[cut - 1]
+            used = sum(cost[a, b] for a, b in zip((0, *pre), pre))
+            mask = np.zeros(n_words(n), dtype=np.uint64)
+            for p in pre:
+                mask[p >> 6] |= np.uint64(1) << np.uint64(p & 63)
+            best_suffix = max(
+                [sum(profit[list(q[cut:])]) for _, q in paths if q[:cut] == pre] or [0.0])
+            ub = _completion(mask, v, budget - used, np.inf, order, profit, cin, reach, lastord, cend)
+            assert ub >= best_suffix - 1e-9
+
+
+def test_ng_route_columns_count_visits():
+    """A repeated point counts twice in its node row (never integer-feasible); routes that stop
+    being ng-routes when the ng sets grow are excluded from the master."""
+    from formulations.bp.master import Master
+    from formulations.bp.pricing import add_to_ng, nearest_ng
+    from formulations.bp.branch_price import NodeState
+
+    m = Master(4, np.ones(4), [(0, 1)], 2)
+    m.add_routes([(1, 2, 3, 1), (1, 2), (3, 4)])
+    assert m.repeated == [0]
+    assert list(m.node_visits(np.array([1.0, 0.0, 0.0]))[1:5]) == [2.0, 1.0, 1.0, 0.0]
+    assert m.milp(5.0) is not None and (1, 2, 3, 1) not in m.milp(5.0)
+    cost = np.abs(np.subtract.outer(np.arange(6.0), np.arange(6.0)))
+    ng = nearest_ng(cost, 1)  # each point remembers only itself: the cycle 1-2-3-1 is an ng-route
+    assert m.kill_non_ng(ng) == 0
+    add_to_ng(ng, 2, 1)
+    add_to_ng(ng, 3, 1)  # now 1 is remembered at 2 and 3: revisiting it is forbidden
+    assert m.kill_non_ng(ng) == 1
+    assert list(m.incompatible(NodeState())) == [True, False, False]
+
+
+@pytest.mark.parametrize("value,n", [(57.3, 5), (57.0, 5), (12.999, 3), (4.2, 1)])
+def test_targeted_slack_keeps_the_floor(value, n):
+    """The raised exact-pricing threshold: dual value + N * (slack + TOL) stays below the next
+    integer (or incumbent + 1), so 'nothing found above the threshold' settles floor(bound)."""
+    from formulations.bp.branch_price import TOL, BranchAndPrice
+
+    inst = TOPInstance(coords=[[1, 0]], prizes=[1], start=[0, 0], end=[0, 0], budget=5.0, n_vehicles=n)
+    bp = BranchAndPrice(inst, time_limit=10)
+    for inc in (None, int(value) - 2, int(value) + 1):
+        bp.incumbent, bp.incumbent_value = (None, -np.inf) if inc is None else ([], float(inc))
+        slack = bp._slack(value)
+        target = max(np.floor(value + 1e-6) + 1, (inc if inc is not None else -np.inf) + 1)
+        assert slack >= 0
+        if slack > 0:
+            assert np.floor(value + n * (slack + TOL) + 1e-6) < target
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_dive_gives_a_verified_plan(seed):
+    """The diving heuristic (root LP, then fixing routes) only returns plans the verifier accepts,
+    never better than enumeration; on these tiny instances it finds the enumerated optimum
+    whenever a plan exists."""
+    from formulations.bp.branch_price import BranchAndPrice, NodeState
+
+    inst = random_tiny(seed, groups=True)
+    best = brute_force(inst)
+    bp = BranchAndPrice(inst, time_limit=20)
+    bp.column_generation(NodeState(), np.inf)
+    bp.dive(5.0)
+    if best is None:
+        assert bp.incumbent is None
+    else:
+        assert bp.incumbent is not None and bp.incumbent_value == pytest.approx(best)

@@ -93,6 +93,9 @@ class BranchAndPrice:
         self.cost = instance.cost_matrix()
         self.budget = instance.budget * (1.0 + 1e-9)
         self.integral = bool(np.all(instance.prizes == np.round(instance.prizes)))
+        # every plan's prize is a multiple of the prizes' gcd (1 for SAR, 10 for TOP set 3)
+        step = math.gcd(*(int(p) for p in instance.prizes)) if self.integral else 0
+        self.step = float(step) if step > 0 else 1.0
         trip = self.cost[0, 1 : self.V + 1] + self.cost[1 : self.V + 1, self.V + 1]
         self.reachable = np.zeros(self.V + 2, dtype=bool)
         self.reachable[1 : self.V + 1] = trip <= self.budget
@@ -120,7 +123,10 @@ class BranchAndPrice:
         return self.deadline - time.perf_counter()
 
     def _floor(self, bound: float) -> float:
-        return math.floor(bound + 1e-6) if self.integral else bound
+        """The bound rounded down to the prize lattice (multiples of the prizes' gcd)."""
+        if not self.integral:
+            return bound
+        return self.step * math.floor((bound + 1e-6) / self.step)
 
     def _offer(self, routes) -> None:
         """Accept a plan (solver points) as incumbent if the verifier agrees and it is better."""
@@ -229,12 +235,13 @@ class BranchAndPrice:
 
     def _slack(self, dual_value: float) -> float:
         """How much the best route's reduced prize may exceed the vehicle dual while
-        dual_value + N·excess stays below the next value that matters (integer prizes only)."""
+        dual_value + N·excess stays below the next value that matters: the next lattice point
+        above dual_value, or incumbent + step if higher (integer prizes only)."""
         if not self.integral:
             return 0.0
-        target = math.floor(dual_value + 1e-6) + 1.0
+        target = self._floor(dual_value) + self.step
         if self.incumbent is not None:
-            target = max(target, self.incumbent_value + 1.0)
+            target = max(target, self.incumbent_value + self.step)
         # reported best >= y0 + slack + TOL, so keep N·TOL and the floor's 1e-6 below target
         return max(0.0, (target - dual_value - 2e-6) / self.N - 2 * TOL)
 
@@ -298,12 +305,14 @@ class BranchAndPrice:
     # -- primal heuristic ------------------------------------------------------------------
     def dive(self, limit: float) -> None:
         """Diving: fix the route of largest LP value (its nodes and arcs forced), re-solve the
-        LP with heuristic pricing only, repeat until the LP solution is integral. Proves
-        nothing; feeds incumbents and columns (the routes that fit together) to the MILP."""
+        LP with heuristic pricing only, repeat until the LP solution is integral. A fixing that
+        leaves the LP infeasible is undone and the next route tried (at most 3 times). Proves
+        nothing; feeds incumbents and columns (routes that fit together) to the MILP."""
         m = self.master
         stop = min(self.deadline, time.perf_counter() + limit)
-        state = NodeState()
-        fixed: set[int] = set()
+        state, parent = NodeState(), None
+        used: set[int] = set()  # routes fixed or tried: never picked again
+        failures = 0
         while time.perf_counter() < stop:
             m.apply(state)
             cost, ret, allowed = self._node_graph(state)
@@ -315,18 +324,23 @@ class BranchAndPrice:
                                   y0=float(y[0]))
                 if not m.add_routes(res.routes):
                     break
-            if xa.max() > TOL:
-                break  # the fixings cannot be completed (as far as heuristic pricing sees)
+            if xa.max() > TOL:  # the fixings cannot be completed (as far as heuristic pricing sees)
+                failures += 1
+                if parent is None or failures > 3:
+                    break
+                state, parent = parent, None
+                continue
             pos = np.flatnonzero(x > TOL)
             if np.all(np.abs(x[pos] - np.round(x[pos])) <= TOL):
                 self._offer([m.routes[r] for r in np.flatnonzero(x > 0.5)])
                 break
-            cand = [r for r in pos if r not in fixed and r not in m.repeated]
+            cand = [r for r in pos if r not in used and r not in m.repeated]
             if not cand:
                 break
             r = max(cand, key=lambda k: x[k])
-            fixed.add(r)
+            used.add(r)
             full = [0, *m.routes[r], self.V + 1]
+            parent = state
             state = state.child(forced_nodes=m.routes[r], forced_arcs=list(zip(full, full[1:])))
 
     # -- branch and bound ------------------------------------------------------------------
