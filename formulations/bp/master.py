@@ -11,14 +11,20 @@ is the same constraint as "some chosen route covers g" because each node is visi
 overall; in the LP it keeps the pricing linear (each node carries its group's dual).
 
 Columns: one artificial per node row and per group row (coefficient +1, prize -BIG: Phase I, so
-that the LP is always feasible, including under "node forced" branches), then the routes.
+that the LP is always feasible, including under "node forced" branches), then the routes. A route
+may be an ng-route that visits a point twice: its node and group coefficients count the visits
+(and its prize counts each visit, as the pricing does), so it cannot appear in an integer solution
+(node rows are <= 1) and the MILP gives it an upper bound of 0. Such routes leave the LP
+(:meth:`Master.kill_non_ng`) once the ng sets grow so that they are no ng-routes any more.
 
 Bound (every round, any duals y with the right signs): for every x feasible in the full master
 (all routes allowed at the branch-and-bound node, no artificials),
 ``prize·x = sum_r rc_r x_r + y·(A x) <= N·max(0, rc*) + sum_k (y_k U_k if y_k > 0 else y_k L_k)``
 with rc_r = p_r - A_r·y (HiGHS's convention) and rc* the best reduced prize over all allowed
 routes (from exact pricing, or any upper bound on it such as ng-route pricing), since
-sum_r x_r <= N and L <= A x <= U. When y is the optimal dual of the restricted LP the second term
+sum_r x_r <= N and L <= A x <= U. Only plans of elementary routes need to satisfy it (they are
+the integer solutions), so the bound stays valid whichever repeated routes the LP holds, and rc*
+may come from ng-route pricing, which covers every elementary route. When y is the optimal dual of the restricted LP the second term
 is its value (with the artificials' prize included, which only lowers it), so this is the usual
 ``z_RMP + N·rc*`` (Farley/Lagrangian) bound. It does not need the LP to be converged or even
 feasible without artificials; duals are clipped to their sign so that the formula holds exactly.

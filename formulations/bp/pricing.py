@@ -11,20 +11,30 @@ One compiled routine (numba) serves three uses, chosen by its arguments:
 * **ng-route relaxation** (``ng[w]`` = a small neighbourhood of w): the remembered set is
   intersected with ng[w] on arrival at w, so some cycles are allowed. Every elementary path is
   still an ng-path, so the best ng-path prize is an upper bound on the best elementary one: the
-  master bound stays valid. Only elementary paths ever become columns; when the best ng-paths
-  are not elementary the caller grows the ng sets along their cycles (decremental state space
-  relaxation) and prices again.
-* **heuristic** (``heuristic=True``): dominance ignores the visited sets (paths stay elementary),
-  so there are few labels per node; fast, finds improving columns, proves nothing.
+  master bound stays valid. Improving elementary paths are returned as ``routes``, improving
+  non-elementary ones as ``ng_routes`` (the master takes both, with visit counts) and their
+  repeated segments as ``cycles`` (for growing the ng sets).
+* **heuristic** (``heuristic=True``): dominance ignores the remembered sets, so there are few
+  labels per node; fast, finds improving columns, proves nothing.
 
-Pruning: a label whose prize plus a fractional-knapsack completion bound (each further node w
-costs at least its cheapest incoming arc, plus one last arc into the end) cannot exceed the
-threshold is dropped. The threshold starts at the vehicle dual (a route must beat it to have a
-positive reduced prize) and, in exact mode, rises to the best complete path found so far. The
-value reported is max(best path found, starting threshold): an upper bound on the best
-*elementary* path (an elementary path's suffix visits distinct nodes that are not in the
-remembered set of any label dominating its prefix, so the once-per-node knapsack bounds it),
-which is all the master's bound needs.
+Pruning: a label whose prize plus a completion bound cannot exceed the threshold is dropped. The
+completion bound (:func:`_completion`) is a fractional knapsack over the positive-prize nodes that
+the label has not remembered and that still fit: a node u is skipped unless ``reach[v, u]``
+(cheapest energy v -> ... -> u -> end over allowed nodes, Floyd-Warshall, no triangle inequality
+assumed) is within the label's remaining energy; each kept node costs at least its cheapest
+incoming arc, and one last arc into the end (the cheapest of a fitting node) is set aside first.
+The threshold starts at ``min_gain`` (the vehicle dual, or more for a targeted call) and, in exact
+mode, rises to the best complete path found so far. The value reported is max(best path found,
+starting threshold): an upper bound on the best *elementary* path (an elementary path's suffix
+visits distinct nodes that are not in the remembered set of any label dominating its prefix, so the
+once-per-node knapsack bounds it), which is all the master's bound needs.
+
+Search order and data layout: labels are extended in order of energy (a binary heap), so a label
+is only extended once every label of lower energy exists: it is never dominated after its
+extensions were made (half the labels of FIFO order on the M = 20 SAR duals). For the dominance
+tests the alive labels of each point sit in a contiguous bucket (energy, prize, remembered set,
+id); a label that dominates a candidate moves halfway to the bucket's front, where the next
+candidates meet it first (one exact call: 1.3 s -> 0.45 s). Paths are kept in creation order.
 
 Bidirectional mode (exact only): the same routine runs forward from the start and backward from
 the end (on the reversed graph), extending labels only up to half the budget, and the halves are
