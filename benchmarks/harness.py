@@ -419,6 +419,10 @@ def run_local(jobs: list[dict], emit, *, workers: int, memory_mb: int = 0) -> No
                 elapsed = time.monotonic() - w.started
                 if dead or not w.proc.is_alive():
                     w.proc.join(1)
+                    if w.proc.exitcode == -signal.SIGINT:
+                        # Ctrl-C reached the worker (a solver library re-armed SIGINT there): the
+                        # user is stopping the run, so its job is not stored and --resume reruns it
+                        raise KeyboardInterrupt
                     emit(failed_row(w.job, "error", _exit_reason(w.proc.exitcode), elapsed))
                 elif elapsed > w.job["time_limit"] + w.job["grace"]:
                     emit(failed_row(w.job, "time_limit",

@@ -50,3 +50,12 @@ def nap(instance, *, seed=0, time_limit=None):
     """Sleeps 2 s whatever its time limit (a finite hang, for the Dask soft deadline)."""
     time.sleep(2.0)
     return all_optimal(instance)
+
+
+def interrupted(instance, *, seed=0, time_limit=None):
+    """Dies by SIGINT, as a worker does when Ctrl-C reaches it inside a solver that re-arms SIGINT."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    os.kill(os.getpid(), signal.SIGINT)
+    time.sleep(5.0)

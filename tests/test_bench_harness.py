@@ -312,3 +312,14 @@ def test_methods_subset_then_rest_with_resume(tmp_path, capsys):
     assert main(["bench", str(suite), "-o", str(tmp_path / "x"), "--methods", "greedy,milp"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "'milp'" in err and "not one of the suite's methods" in err
+
+
+def test_ctrl_c_in_a_worker_stops_the_run_without_storing_its_job(tmp_path, capsys):
+    """A worker killed by SIGINT means the user pressed Ctrl-C: exit 130 and the job is not stored
+    as an error (so --resume runs it again)."""
+    body = 'methods = ["bench_methods:interrupted"]\ntime_limit = 5\n[[instances]]\nM = 2\nK = 2\nN = 1\nruns = 1\n'
+    suite = write_suite(tmp_path, body)
+    out = tmp_path / "res"
+    assert main(["bench", str(suite), "-o", str(out), "--workers", "1", "--quiet"]) == 130
+    text = (out / "results.jsonl").read_text() if (out / "results.jsonl").exists() else ""
+    assert "interrupted" not in text
