@@ -97,7 +97,7 @@ class _Stats:
 class BranchAndPrice:
     def __init__(self, instance: TOPInstance, *, time_limit: float | None, ng_size: int = 8,
                  initial_routes=None, bidirectional: bool | None = None, ng_columns: bool = True,
-                 ng_cap: int = 16):
+                 ng_cap: int = 12, grow_share: float = 0.3):
         self.bidirectional = bidirectional
         self.ng_columns = ng_columns
         self.ng_cap = ng_cap
@@ -106,6 +106,8 @@ class BranchAndPrice:
         limit = float(time_limit) if time_limit is not None else math.inf
         self.dive_limit = 0.1 * limit if math.isfinite(limit) else 30.0
         self.dived = False
+        self.dive_starts: set[int] = set()  # first route fixed by each dive so far
+        self.grow_until = self.t0 + (grow_share * limit if math.isfinite(limit) else math.inf)
         self.hard_deadline = self.t0 + limit
         self.reserve = min(5.0, 0.1 * limit)  # kept for a last MILP over the generated routes
         self.deadline = self.hard_deadline - self.reserve
@@ -232,6 +234,8 @@ class BranchAndPrice:
         point along its cycle (ng sets capped at ``ng_cap``), exclude the routes that stop being
         ng-routes, and report whether anything changed (the LP is then re-solved)."""
         m = self.master
+        if time.perf_counter() > self.grow_until:
+            return False  # growing makes pricing slower: past this point, branching decides
         grown = False
         for r in m.repeated:
             if x[r] <= TOL or r in m.dead:
@@ -339,6 +343,14 @@ class BranchAndPrice:
         leaves the LP infeasible is undone and the next route tried (at most 3 times). Proves
         nothing; feeds incumbents and columns (routes that fit together) to the MILP."""
         m = self.master
+        m.hide_repeated = True  # plans are made of elementary routes: ng-routes would only mislead
+        try:
+            self._dive(limit, start)
+        finally:
+            m.hide_repeated = False
+
+    def _dive(self, limit: float, start: NodeState | None) -> None:
+        m = self.master
         stop = min(self.deadline, time.perf_counter() + limit)
         state, parent = (start or NodeState()), None
         used: set[int] = set()  # routes fixed or tried: never picked again
@@ -348,6 +360,8 @@ class BranchAndPrice:
             cost, ret, allowed = self._node_graph(state)
             for _ in range(200):
                 value, x, xa, y = m.solve()
+                if xa.max() <= TOL and np.all(np.abs(x - np.round(x)) <= TOL):
+                    self._offer([m.routes[r] for r in np.flatnonzero(x > 0.5)])
                 if time.perf_counter() >= stop:
                     break
                 res = self._price(cost, ret, m.point_profit(y), allowed, heuristic=True,
@@ -364,10 +378,14 @@ class BranchAndPrice:
             if np.all(np.abs(x[pos] - np.round(x[pos])) <= TOL):
                 self._offer([m.routes[r] for r in np.flatnonzero(x > 0.5)])
                 break
-            cand = [r for r in pos if r not in used and r not in m.repeated]
+            cand = [r for r in pos if r not in used]
+            if not used:  # first fixing: not one a previous dive started from (diversity)
+                cand = [r for r in cand if r not in self.dive_starts] or cand
             if not cand:
                 break
             r = max(cand, key=lambda k: x[k])
+            if not used:
+                self.dive_starts.add(r)
             used.add(r)
             full = [0, *m.routes[r], self.V + 1]
             parent = state
@@ -433,7 +451,7 @@ class BranchAndPrice:
                 break
             if self._prunable(bound):
                 continue
-            if self.stats.nodes % 8 == 0 and self._time_left() > 0:
+            if self.stats.nodes % 4 == 0 and self._time_left() > 0:
                 # dive again from this node (other fixings than the root's dive)
                 self.dive(min(0.3 * self.dive_limit, 0.25 * self._time_left()), start=state)
                 self.master.apply(state)
@@ -471,7 +489,7 @@ class BranchAndPrice:
 
 def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
              initial_routes=None, ng_size: int = 8, bidirectional: bool | None = None,
-             ng_columns: bool = True, ng_cap: int = 16) -> Result:
+             ng_columns: bool = True, ng_cap: int = 12, grow_share: float = 0.3) -> Result:
     """Branch-and-price: proven optimum, or the best plan and a certified bound at the limit.
 
     ``initial_routes`` (node ids, e.g. a heuristic plan's routes) are added as starting columns
@@ -486,7 +504,7 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
         return Result("bp", Status.INFEASIBLE, reason=reason, runtime_s=time.perf_counter() - t0)
     bp = BranchAndPrice(instance, time_limit=time_limit, ng_size=ng_size,
                         initial_routes=initial_routes, bidirectional=bidirectional,
-                        ng_columns=ng_columns, ng_cap=ng_cap)
+                        ng_columns=ng_columns, ng_cap=ng_cap, grow_share=grow_share)
     proven, bound = bp.run()
     st = bp.stats
     info = {

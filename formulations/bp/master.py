@@ -74,6 +74,7 @@ class Master:
         self._pred = np.full((cap, self.V + 2), -1, dtype=np.int32)
         self.repeated: list[int] = []  # routes (ng-routes) that visit some point twice
         self.dead: set[int] = set()  # repeated routes that are no ng-routes of the grown ng sets
+        self.hide_repeated = False  # True while a primal heuristic wants elementary routes only
         self.col_ub = np.zeros(0)
         self.cur_lo = self.row_lo.copy()
 
@@ -154,7 +155,7 @@ class Master:
                 bad |= (visit[:, b] > 0) & (pred[:, b] != a)
         # succ/pred keep only the last visit of a repeated point: check those routes arc by arc
         for r in self.repeated:
-            if r in self.dead:
+            if r in self.dead or self.hide_repeated:
                 bad[r] = True
                 continue
             full = [0, *self.routes[r], end]
