@@ -57,8 +57,9 @@ _SPECS = [
                "PyVRP iterated local search, optional clients with prizes, max distance = energy, 2000 its"),
     MethodSpec("milp", "heuristics.milp_warm:milp", True,
                "time-flow TOP MILP on HiGHS via Pyomo: pruned arcs, cliques, path + connectivity cuts, 1 thread, gap 0"),
-    MethodSpec("bp", "formulations.bp:solve_bp", True,
-               "branch-and-price: route master on HiGHS, ng-route labelling pricing (numba), 1 thread"),
+    MethodSpec("bp", "heuristics.bp_warm:bp", True,
+               "branch-and-price: route master on HiGHS, ng-route labelling pricing (numba), greedy's routes "
+               "as first columns, 1 thread"),
 ]
 
 METHODS: dict[str, MethodSpec] = {spec.name: spec for spec in _SPECS}

@@ -306,3 +306,17 @@ def test_dive_gives_a_verified_plan(seed):
         assert bp.incumbent is None
     else:
         assert bp.incumbent is not None and bp.incumbent_value == pytest.approx(best)
+
+
+def test_registered_bp_starts_from_greedy():
+    """The registered `bp` gets greedy's routes as first columns: stopped almost at once on a
+    paper-size instance it still returns a verified plan at least as good as greedy's, under its bound."""
+    from formulations.generate import generate
+    from formulations.instance import to_top
+
+    inst = to_top(generate(20, 3, 5, 11))
+    g, _ = run_method("greedy", inst)
+    r, rep = run_method("bp", inst, time_limit=0.5)
+    assert g.status == Status.FEASIBLE and r.plan is not None and rep.valid
+    assert r.objective >= g.objective and r.bound >= r.objective
+    assert r.info["warm_start_prize"] == g.objective
