@@ -25,7 +25,7 @@ from heuristics.repair import Repairer
 def greedy(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:
     """Deterministic insertion heuristic (``seed`` and ``time_limit`` are accepted and unused)."""
     t0 = time.perf_counter()
-    repairer = Repairer(instance, D=np.empty((0, 0)))  # D is only for 2-opt, which greedy never runs
+    repairer = Repairer(instance)
     rs = RouteSet(instance, repairer.C)
     reach = np.zeros(instance.n_nodes + 2, dtype=bool)
     reach[1:-1] = instance.reachable()

@@ -96,41 +96,9 @@ if HAVE_NUMBA:
         for b in range(B):
             n = sizes[b]
             for p in range(P):
-                for i in range(n):  # insertion sort of the (few) real keys: no allocation
-                    k = keys[b, p, i]
-                    j = i
-                    while j > 0 and keys[b, p, order[j - 1]] > k:
-                        order[j] = order[j - 1]
-                        j -= 1
-                    order[j] = i
+                _sort_real(keys[b, p], n, order)
                 out[b, p] = _path_length(D, nodes[b], order, n, start, end)
         return out
-
-    @njit(cache=True, nogil=True)
-    def pso_step(x, v, pbest, pbest_f, gbest, r1, r2, w, c1, c2, v_max,
-                 D, nodes, sizes, start, end):  # pragma: no cover - compiled
-        """One in-place PSO move of every particle (same arithmetic order as the numpy code):
-        v ← clip(w·v + c1·r1·(pbest−x) + c2·r2·(gbest−x)), x ← x + v, then fitness and pbest."""
-        B, P, L = x.shape
-        for b in range(B):
-            for p in range(P):
-                for i in range(L):
-                    vi = w * v[b, p, i] + c1 * r1[b, p, i] * (pbest[b, p, i] - x[b, p, i]) \
-                        + c2 * r2[b, p, i] * (gbest[b, i] - x[b, p, i])
-                    if vi < -v_max:
-                        vi = -v_max
-                    elif vi > v_max:
-                        vi = v_max
-                    v[b, p, i] = vi
-                    x[b, p, i] = x[b, p, i] + vi
-        f = keyed_lengths(D, x, nodes, sizes, start, end)
-        for b in range(B):
-            for p in range(P):
-                if f[b, p] < pbest_f[b, p]:
-                    pbest_f[b, p] = f[b, p]
-                    for i in range(L):
-                        pbest[b, p, i] = x[b, p, i]
-        return f
 
     @njit(cache=True, nogil=True)
     def ga_children(pop, win, lo1, hi1, cross, lo2, hi2, mutate):  # pragma: no cover - compiled

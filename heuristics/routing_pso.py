@@ -123,7 +123,7 @@ class PSORouter:
         return best, gbest_f
 
     def _move(self, x, v, pbest, pbest_f, gbest, r1, r2, evaluate):
-        """numpy version of :func:`heuristics.kernels.pso_step`."""
+        """One PSO move, fitness and personal bests in numpy (:func:`heuristics.kernels.pso_iterations` compiled)."""
         v = self.w * v + self.c1 * r1 * (pbest - x) + self.c2 * r2 * (gbest[:, None, :] - x)
         np.clip(v, -self.v_max, self.v_max, out=v)
         x = x + v
