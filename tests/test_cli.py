@@ -30,6 +30,18 @@ def test_generate_solve_json_and_plot(tmp_path):
     assert (tmp_path / "p.png").read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.parametrize("method", ["milp", "cpsat", "bp"])
+def test_solve_json_stdout_is_one_object_for_exact_methods(tmp_path, method):
+    """`solve --json` prints exactly one JSON object: no solver banner (HiGHS prints one from C++
+    when a highspy model is built) may reach stdout."""
+    inst = tmp_path / "i.json"
+    assert main(["generate", "-M", "4", "-K", "2", "-N", "2", "--seed", "1", "-o", str(inst)]) == 0
+    out = run("solve", str(inst), "--method", method, "--json", "--time-limit", "20")
+    assert out.returncode == 0, out.stderr
+    rec = json.loads(out.stdout)
+    assert rec["method"] == method and rec["status"] == "optimal" and rec["valid"] is True
+
+
 def test_solve_top_file_summary():
     """A TOP benchmark file solves; the readable summary names method and objective."""
     out = run("solve", str(TOP_DIR / "p2.2.k.txt"))

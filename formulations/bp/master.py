@@ -34,8 +34,20 @@ from __future__ import annotations
 
 import highspy
 import numpy as np
+from pyomo.common.tee import capture_output
 
 INF = highspy.kHighsInf
+
+
+def quiet_highs() -> highspy.Highs:
+    """A silent single-thread HiGHS. Its constructor prints a banner on file descriptor 1 (C++
+    output: `sarcover solve --json` must print one JSON object only), so it is built with fd 1
+    captured, as Pyomo's own HiGHS interface does."""
+    with capture_output(capture_fd=True):
+        h = highspy.Highs()
+    h.setOptionValue("output_flag", False)
+    h.setOptionValue("threads", 1)
+    return h
 
 
 class Master:
@@ -52,9 +64,7 @@ class Master:
         self.n_rows = 1 + self.V + self.G
         self.row_lo = np.concatenate([[-INF], np.full(self.V, -INF), np.ones(self.G)])
         self.row_hi = np.concatenate([[float(n_vehicles)], np.ones(self.V), np.full(self.G, INF)])
-        h = highspy.Highs()
-        h.setOptionValue("output_flag", False)
-        h.setOptionValue("threads", 1)
+        h = quiet_highs()
         h.changeObjectiveSense(highspy.ObjSense.kMaximize)
         h.addRows(self.n_rows, self.row_lo, self.row_hi, 0, np.zeros(self.n_rows, np.int32),
                   np.zeros(0, np.int32), np.zeros(0))
@@ -250,9 +260,7 @@ class Master:
         k = self.n_routes
         if k == 0:
             return None
-        h = highspy.Highs()
-        h.setOptionValue("output_flag", False)
-        h.setOptionValue("threads", 1)
+        h = quiet_highs()
         h.setOptionValue("time_limit", max(0.05, float(time_limit)))
         h.setOptionValue("mip_rel_gap", 0.0)
         h.changeObjectiveSense(highspy.ObjSense.kMaximize)
