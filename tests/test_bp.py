@@ -320,3 +320,141 @@ def test_registered_bp_starts_from_greedy():
     assert g.status == Status.FEASIBLE and r.plan is not None and rep.valid
     assert r.objective >= g.objective and r.bound >= r.objective
     assert r.info["warm_start_prize"] == g.objective
+
+
+# -- limited-memory subset-row cuts ------------------------------------------------------------
+
+def test_lm_coefficient_counts_pairs_and_forgets_outside_memory():
+    """Pairs of visits to the triple; an unpaired visit is forgotten at a point outside the
+    memory, so the coefficient never exceeds floor(visits / 2) (the full cut's)."""
+    from formulations.bp.master import _lm_coefficient
+
+    S, full = (1, 2, 3), frozenset(range(10))
+    assert _lm_coefficient((1, 5, 2), S, full) == 1
+    assert _lm_coefficient((1, 5, 2), S, frozenset({1, 2, 3})) == 0  # 5 makes it forget 1
+    assert _lm_coefficient((1, 5, 2), S, frozenset({1, 2, 3, 5})) == 1
+    assert _lm_coefficient((1, 2, 3), S, frozenset(S)) == 1
+    assert _lm_coefficient((4, 6), S, full) == 0
+    assert _lm_coefficient((1, 2, 1, 2), S, full) == 2  # an ng-route's repeated visits count
+
+
+def _random_cuts(rng, n, n_cuts):
+    """Random triples of inner points, memories of S plus random points, positive duals."""
+    inner = np.arange(1, n - 1)
+    cuts, mems = [], []
+    for _ in range(n_cuts):
+        S = tuple(int(p) for p in rng.choice(inner, 3, replace=False))
+        extra = rng.choice(inner, int(rng.integers(0, len(inner))), replace=False)
+        cuts.append(S)
+        mems.append(frozenset(S) | {int(p) for p in extra})
+    members = np.zeros(n, dtype=np.uint64)
+    memory = np.zeros(n, dtype=np.uint64)
+    for c, (S, M) in enumerate(zip(cuts, mems)):
+        for p in S:
+            members[p] |= np.uint64(1) << np.uint64(c)
+        for p in M:
+            memory[p] |= np.uint64(1) << np.uint64(c)
+    return cuts, mems, members, memory, rng.uniform(0.05, 0.8, n_cuts)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_exact_pricing_with_cuts_matches_enumeration(seed):
+    """With subset-row cut duals, exact elementary labelling finds the best path's prize minus
+    the duals of the cuts it pays (limited-memory coefficients, enumerated); every route it
+    returns has the value it claims to beat; ng labelling stays an upper bound."""
+    from formulations.bp.master import _lm_coefficient
+    from formulations.bp.pricing import full_ng, nearest_ng, price
+
+    rng = np.random.default_rng(100 + seed)
+    cost, ret, profit, budget = _tiny_pricing(seed)
+    n = cost.shape[0]
+    cuts, mems, members, memory, sig = _random_cuts(rng, n, 6)
+
+    def value(path):
+        pen = sum(s * _lm_coefficient(path, S, M) for S, M, s in zip(cuts, mems, sig))
+        return float(profit[list(path)].sum()) - pen
+
+    paths = [(value(p), p) for _, p in _brute_paths(cost, profit, budget)]
+    best = max(v for v, _ in paths)
+    gain = 0.2 * best
+    kw = dict(max_labels=1_000_000, n_cols=50, min_gain=gain, cut_members=members,
+              cut_memory=memory, cut_duals=sig)
+    allowed = np.ones(n, dtype=bool)
+    ex = price(cost, ret, profit, budget, full_ng(n), allowed, heuristic=False, **kw)
+    assert ex.exact and ex.best == pytest.approx(max(best, gain))
+    vals = {p: v for v, p in paths}
+    assert ex.routes and vals[ex.routes[0]] == pytest.approx(best)
+    assert all(vals[r] > gain - 1e-9 for r in ex.routes)
+    ng = price(cost, ret, profit, budget, nearest_ng(cost, 2), allowed, heuristic=False, **kw)
+    assert ng.exact and ng.best >= best - 1e-9
+    # bidirectional search is switched off with cuts (its join does not track them): same value
+    bi = price(cost, ret, profit, budget, full_ng(n), allowed, heuristic=False, bidirectional=True, **kw)
+    assert bi.best == pytest.approx(ex.best)
+
+
+def test_master_cut_rows_hold_lm_coefficients():
+    """Cut rows get the limited-memory coefficient of routes generated before and after the
+    cut; separation finds a violated triple in a fractional LP and its memory keeps it violated."""
+    from formulations.bp.master import Master, _lm_coefficient
+
+    m = Master(6, np.ones(6), [], 3)
+    m.add_routes([(1, 2), (2, 3), (1, 3)])  # each x = 1/2 violates the cut on {1, 2, 3}: 3/2 > 1
+    x = np.full(3, 0.5)
+    cuts = m.separate_cuts(x, 4)
+    assert [S for S, _ in cuts] == [(1, 2, 3)]
+    assert m.add_cuts(cuts) == 1 and m.cuts == [(1, 2, 3)]
+    m.add_routes([(1, 4, 2), (4, 5)])
+    lp = m.h.getLp()
+    a = lp.a_matrix_
+    row = m.base_rows
+    got = {}
+    for j in range(m.n_routes):
+        col = m.n_art + j
+        lo, hi = a.start_[col], a.start_[col + 1]
+        coef = dict(zip(a.index_[lo:hi], a.value_[lo:hi]))
+        got[m.routes[j]] = coef.get(row, 0.0)
+        assert got[m.routes[j]] == _lm_coefficient(m.routes[j], (1, 2, 3), m.memories[0])
+    assert got[(1, 2)] == 1 and got[(4, 5)] == 0
+    value, xs, xa, y = m.solve()
+    assert sum(got[r] * xs[j] for j, r in enumerate(m.routes)) <= 1.0 + 1e-9  # the cut holds
+    # memory {1, 2, 3}: (1, 4, 2) forgets 1 at 4 and pays nothing, so the LP uses it at 1/2
+    assert got[(1, 4, 2)] == 0 and value == pytest.approx(4.5)
+    assert m.cut_duals(y).shape == (1,)
+
+
+@pytest.mark.parametrize("name", ["p1.3.n", "p3.3.k", "p2.2.k"])
+def test_cuts_keep_the_published_optimum(name):
+    """With subset-row cuts forced on (these files get 9 to 36 cuts at the root), bp still proves
+    exactly the published optimum with a verified plan."""
+    inst = load_instance(TOP_DIR / f"{name}.txt")
+    r = solve_bp(inst, time_limit=60, cut_rounds=4, cut_gap=100.0, cut_share=1.0)
+    assert r.info["cuts"] > 0
+    assert r.status == Status.OPTIMAL
+    assert sum(inst.prizes[v] for v in r.plan.visited) == pytest.approx(OPTIMAL[name])
+    assert r.bound == pytest.approx(OPTIMAL[name])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_cuts_match_brute_force(seed):
+    """Tiny random instances with groups, cuts forced on: same optimum as enumeration."""
+    inst = random_tiny(seed, groups=True)
+    best = brute_force(inst)
+    r = solve_bp(inst, time_limit=30, cut_rounds=4, cut_gap=100.0, cut_share=1.0)
+    if best is None:
+        assert r.status == Status.INFEASIBLE
+    else:
+        assert r.status == Status.OPTIMAL
+        assert sum(inst.prizes[v] for v in r.plan.visited) == pytest.approx(best)
+
+
+def test_cuts_are_on_by_default_for_long_runs_only():
+    """Cuts slow pricing down; by default they are used from CUTS_FROM_S seconds (and without a
+    limit) and can be forced either way."""
+    from formulations.bp.branch_price import CUTS_FROM_S, BranchAndPrice
+
+    inst = random_tiny(0, groups=False)
+    assert BranchAndPrice(inst, time_limit=60).cut_rounds == 0
+    assert BranchAndPrice(inst, time_limit=CUTS_FROM_S).cut_rounds > 0
+    assert BranchAndPrice(inst, time_limit=None).cut_rounds > 0
+    assert BranchAndPrice(inst, time_limit=None, cut_rounds=0).cut_rounds == 0
+    assert BranchAndPrice(inst, time_limit=10, cut_rounds=2).cut_rounds == 2

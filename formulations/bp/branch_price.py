@@ -20,6 +20,15 @@ labelling pricing (:mod:`.pricing`):
    being ng-routes leave the master, and column generation continues on the stronger relaxation.
    Larger ng sets make pricing slower, so sets only grow in the first ``grow_share`` (30 %) of the
    time limit; after that, branching decides.
+5. limited-memory subset-row cuts (:mod:`.master`), on by default for time limits of at least
+   ``CUTS_FROM_S`` (120 s; ``cut_rounds`` = 0 turns them off, a number turns them on): at the
+   root, once the floored bound is settled and the ng sets stop growing, up to ``cut_rounds``
+   (4) rounds of ``cuts_per_round``
+   (16) most violated triples (at most 64 in all), each followed by column generation with the
+   cut duals in the pricing. Cuts make every later pricing slower (labels carry cut parities and
+   dominate less), so they are tried only within the first ``cut_share`` (35 %) of the time limit
+   and only while the restricted LP is within ``cut_gap`` (half a prize step) of proving the
+   incumbent or of lowering its own floor by one step.
 
 Branching, in order: on a fractional node visit (forbid the node / force it visited: a forced node
 row becomes ``= 1``); then, when all visits are integral, on a fractional arc flow (forbid the arc
@@ -71,6 +80,7 @@ from formulations.plan import Plan, Result, Status
 from formulations.verify import verify
 
 TOL = 1e-6
+CUTS_FROM_S = 120.0  # time limits from which subset-row cuts are on by default
 
 
 @dataclass(frozen=True)
@@ -97,6 +107,8 @@ class _Stats:
     ng_growths: int = 0
     nodes: int = 0
     milp_calls: int = 0
+    cuts: int = 0
+    root_lp: float | None = None  # restricted root LP value when cuts were first considered
     pricing_s: float = 0.0
     lp_s: float = 0.0
     root_bound: float | None = None
@@ -108,7 +120,15 @@ class _Stats:
 class BranchAndPrice:
     def __init__(self, instance: TOPInstance, *, time_limit: float | None, ng_size: int = 8,
                  initial_routes=None, bidirectional: bool | None = None, ng_columns: bool = True,
-                 ng_cap: int = 12, grow_share: float = 0.3):
+                 ng_cap: int = 12, grow_share: float = 0.3, cut_rounds: int | None = None,
+                 cuts_per_round: int = 16, cut_gap: float = 0.5, cut_share: float = 0.35):
+        if cut_rounds is None:  # auto: cuts only pay back their slower pricing on long runs
+            long_run = time_limit is None or float(time_limit) >= CUTS_FROM_S
+            cut_rounds = 4 if long_run else 0
+        self.cut_rounds = cut_rounds
+        self.cut_gap = cut_gap
+        self.cuts_per_round = cuts_per_round
+        self.cut_round = 0
         self.bidirectional = bidirectional
         self.ng_columns = ng_columns
         self.ng_cap = ng_cap
@@ -119,6 +139,7 @@ class BranchAndPrice:
         self.dived = False
         self.dive_starts: set[int] = set()  # first route fixed by each dive so far
         self.grow_until = self.t0 + (grow_share * limit if math.isfinite(limit) else math.inf)
+        self.cut_until = self.t0 + (cut_share * limit if math.isfinite(limit) else math.inf)
         self.hard_deadline = self.t0 + limit
         self.reserve = min(5.0, 0.1 * limit)  # kept for a last MILP over the generated routes
         self.deadline = self.hard_deadline - self.reserve
@@ -204,36 +225,38 @@ class BranchAndPrice:
             allowed[p] = False
         return cost, cheapest_return(cost), allowed
 
-    def _price(self, cost, ret, prof, allowed, *, heuristic, y0, max_labels=None):
+    def _price(self, cost, ret, prof, allowed, *, heuristic, y0, sig, max_labels=None):
         """Pricing; ``y0`` is the threshold a path's reduced prize must beat (the vehicle dual,
-        or more for a targeted exact call)."""
+        or more for a targeted exact call); ``sig``: the subset-row cuts' duals."""
         t = time.perf_counter()
         if max_labels is None:
             max_labels = 200_000 if heuristic else 2_000_000
         res = price(cost, ret, prof, self.budget, self.ng, allowed, heuristic=heuristic,
                     max_labels=max_labels, n_cols=30 if heuristic else 60,
                     min_gain=y0 + TOL, deadline=self.deadline,
-                    bidirectional=bool(self.bidirectional) and not heuristic)
+                    bidirectional=bool(self.bidirectional) and not heuristic,
+                    cut_members=self.master.cut_members, cut_memory=self.master.cut_memory,
+                    cut_duals=sig)
         self.stats.pricing_s += time.perf_counter() - t
         self.stats.labels += res.n_labels
         return res
 
-    def _exact_price(self, cost, ret, prof, allowed, y0):
+    def _exact_price(self, cost, ret, prof, allowed, y0, sig):
         """Exact pricing. On the first call both searches run, the bidirectional one under the
         one-way search's time; the faster is kept for the rest of the run (neither dominates:
         bidirectional wins on long routes with many labels, loses when the join is large)."""
         if self.bidirectional is not None:
-            return self._price(cost, ret, prof, allowed, heuristic=False, y0=y0)
+            return self._price(cost, ret, prof, allowed, heuristic=False, y0=y0, sig=sig)
         t = time.perf_counter()
         self.bidirectional = False
-        uni = self._price(cost, ret, prof, allowed, heuristic=False, y0=y0)
+        uni = self._price(cost, ret, prof, allowed, heuristic=False, y0=y0, sig=sig)
         t_uni = time.perf_counter() - t
         if not uni.exact:
             return uni
         saved, self.deadline = self.deadline, min(self.deadline, time.perf_counter() + 0.8 * t_uni)
         t = time.perf_counter()
         self.bidirectional = True
-        bi = self._price(cost, ret, prof, allowed, heuristic=False, y0=y0)
+        bi = self._price(cost, ret, prof, allowed, heuristic=False, y0=y0, sig=sig)
         self.deadline = saved
         t_bi = time.perf_counter() - t
         self.stats.mode_times = (round(t_uni, 4), round(t_bi, 4))
@@ -299,12 +322,13 @@ class BranchAndPrice:
             if self._time_left() <= 0:
                 return bound, x, xa, False
             prof = m.point_profit(y)
+            sig = m.cut_duals(y)
             allowed = allowed_base.copy()
             if not arcs_decided:
                 # With the triangle inequality a node of reduced prize <= 0 can be skipped.
                 allowed &= prof > 1e-12
             y0 = float(y[0])
-            res = self._price(cost, ret, prof, allowed, heuristic=True, y0=y0)
+            res = self._price(cost, ret, prof, allowed, heuristic=True, y0=y0, sig=sig)
             if m.add_routes(self._columns(res)):
                 continue
             if self._time_left() <= 0:
@@ -314,7 +338,7 @@ class BranchAndPrice:
             # may add to the dual value without reaching the next integer (or incumbent + 1).
             # If none does, floor(bound) is settled: the node is pruned or branched on now.
             gain = y0 + self._slack(m.lagrangian_bound(y, y0))
-            res = self._exact_price(cost, ret, prof, allowed, gain)
+            res = self._exact_price(cost, ret, prof, allowed, gain, sig)
             self.stats.exact_pricings += 1
             if res.exact:
                 bound = min(bound, m.lagrangian_bound(y, res.best))
@@ -345,7 +369,32 @@ class BranchAndPrice:
             if self._grow_ng_from_lp(x):
                 m.apply(state)
                 continue
+            if self._add_cuts(state, x, value):
+                continue
             return bound, x, xa, True
+
+    def _add_cuts(self, state: NodeState, x, lp_value: float) -> bool:
+        """Subset-row cuts on triples violated by the node's LP solution; report whether any was
+        added. Cuts make every later pricing slower (labels pay their duals and dominate less),
+        so they are only tried at the root, within the first ``cut_share`` of the time limit,
+        while the restricted LP value is less than ``cut_gap`` steps above the value that would
+        prove the incumbent optimal or above its own floor (a small drop then lowers the floored
+        bound; larger drops are rare, and branching does better)."""
+        if state.depth > 0 or self.cut_round >= self.cut_rounds or self._time_left() <= 0:
+            return False
+        if self.incumbent is None or time.perf_counter() > self.cut_until:
+            return False
+        if self.stats.root_lp is None:
+            self.stats.root_lp = lp_value
+        # the drop that proves the incumbent optimal, or lowers the floored bound by one step
+        need = min(lp_value - (self.incumbent_value + self.step), lp_value - self._floor(lp_value))
+        if need > self.cut_gap * self.step:
+            return False
+        self.cut_round += 1
+        cuts = self.master.separate_cuts(x, self.cuts_per_round)
+        added = self.master.add_cuts(cuts)
+        self.stats.cuts += added
+        return added > 0
 
     # -- primal heuristic ------------------------------------------------------------------
     def dive(self, limit: float, start: NodeState | None = None) -> None:
@@ -376,7 +425,7 @@ class BranchAndPrice:
                 if time.perf_counter() >= stop:
                     break
                 res = self._price(cost, ret, m.point_profit(y), allowed, heuristic=True,
-                                  y0=float(y[0]))
+                                  y0=float(y[0]), sig=m.cut_duals(y))
                 if not m.add_routes(res.routes):
                     break
             if xa.max() > TOL:  # the fixings cannot be completed (as far as heuristic pricing sees)
@@ -500,7 +549,9 @@ class BranchAndPrice:
 
 def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
              initial_routes=None, ng_size: int = 8, bidirectional: bool | None = None,
-             ng_columns: bool = True, ng_cap: int = 12, grow_share: float = 0.3) -> Result:
+             ng_columns: bool = True, ng_cap: int = 12, grow_share: float = 0.3,
+             cut_rounds: int | None = None, cuts_per_round: int = 16, cut_gap: float = 0.5,
+             cut_share: float = 0.35) -> Result:
     """Branch-and-price: proven optimum, or the best plan and a certified bound at the limit.
 
     ``initial_routes`` (node ids, e.g. a heuristic plan's routes) are added as starting columns
@@ -515,13 +566,15 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
         return Result("bp", Status.INFEASIBLE, reason=reason, runtime_s=time.perf_counter() - t0)
     bp = BranchAndPrice(instance, time_limit=time_limit, ng_size=ng_size,
                         initial_routes=initial_routes, bidirectional=bidirectional,
-                        ng_columns=ng_columns, ng_cap=ng_cap, grow_share=grow_share)
+                        ng_columns=ng_columns, ng_cap=ng_cap, grow_share=grow_share,
+                        cut_rounds=cut_rounds, cuts_per_round=cuts_per_round, cut_gap=cut_gap,
+                        cut_share=cut_share)
     proven, bound = bp.run()
     st = bp.stats
     info = {
         "nodes": st.nodes, "rounds": st.rounds, "columns": bp.master.n_routes,
         "exact_pricings": st.exact_pricings, "labels": st.labels, "ng_growths": st.ng_growths,
-        "milp_calls": st.milp_calls, "pricing_s": round(st.pricing_s, 3), "lp_s": round(st.lp_s, 3),
+        "milp_calls": st.milp_calls, "cuts": st.cuts, "root_lp": st.root_lp, "pricing_s": round(st.pricing_s, 3), "lp_s": round(st.lp_s, 3),
         "root_bound": st.root_bound, "root_s": st.root_s, "history": st.history, "threads": 1,
         "bidirectional": bp.bidirectional, "mode_times": st.mode_times,
     }

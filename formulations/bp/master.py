@@ -5,6 +5,16 @@ Rows (solver order, point p = node id + 1)::
     row 0            sum_r x_r                 <= N     (vehicles)
     row p, p=1..V    sum_r a_pr x_r            <= 1     (each node at most once; = 1 when forced)
     row V+1+g        sum_r sum_{p in g} a_pr x_r >= 1   (group g covered)
+    row V+1+G+c      sum_r floor(a_Sr / 2) x_r  <= 1   (subset-row cut c on a triple S)
+
+Subset-row cuts (Jepsen, Petersen, Spoorendonk & Pisinger 2008) are valid for every plan of
+elementary routes: at most one chosen route visits two points of S, because each point is visited
+once. Limited memory (Pecin, Pessoa, Poggi & Uchoa 2017): each cut has a memory M ⊇ S of points;
+along a route, an unpaired visit to S is forgotten at a point outside M, and ``a_Sr`` counts the
+pairs made (repeated visits of an ng-route included, as the pricing counts them). That is at most
+floor(visits to S / 2), so the cut stays valid; M is chosen from the LP routes that violate the
+full cut, so that the separated violation is kept. At most :data:`MAX_CUTS` (one 64-bit word in
+the labels).
 
 The group row counts visits (a route through two nodes of one group counts 2). For integer x this
 is the same constraint as "some chosen route covers g" because each node is visited at most once
@@ -37,6 +47,7 @@ import numpy as np
 from pyomo.common.tee import capture_output
 
 INF = highspy.kHighsInf
+MAX_CUTS = 64
 
 
 def quiet_highs() -> highspy.Highs:
@@ -48,6 +59,19 @@ def quiet_highs() -> highspy.Highs:
     h.setOptionValue("output_flag", False)
     h.setOptionValue("threads", 1)
     return h
+
+
+def _lm_coefficient(route, S, memory) -> int:
+    """Pairs of visits to S along the route, an unpaired visit forgotten outside ``memory``."""
+    odd, pairs = False, 0
+    for p in route:
+        if p not in memory:
+            odd = False
+        elif p in S:
+            if odd:
+                pairs += 1
+            odd = not odd
+    return pairs
 
 
 class Master:
@@ -87,6 +111,11 @@ class Master:
         self.hide_repeated = False  # True while a primal heuristic wants elementary routes only
         self.col_ub = np.zeros(0)
         self.cur_lo = self.row_lo.copy()
+        self.cuts: list[tuple[int, ...]] = []  # subset-row triples (solver points)
+        self.cut_members = np.zeros(self.V + 2, dtype=np.uint64)  # bitset of cuts per point
+        self.cut_memory = np.zeros(self.V + 2, dtype=np.uint64)  # cuts remembering each point
+        self.memories: list[frozenset] = []
+        self.base_rows = self.n_rows
 
     # -- columns ---------------------------------------------------------------------------
     @property
@@ -135,6 +164,10 @@ class Master:
                 if g >= 0:
                     row = 1 + self.V + g
                     coef[row] = coef.get(row, 0.0) + 1.0
+            for c, S in enumerate(self.cuts):
+                a = _lm_coefficient(r, S, self.memories[c])
+                if a:
+                    coef[self.base_rows + c] = float(a)
             starts.append(nnz)
             rows = sorted(coef)
             idx.extend(rows)
@@ -146,6 +179,101 @@ class Master:
                        np.asarray(starts, np.int32), np.asarray(idx, np.int32), np.asarray(vals))
         self.col_ub = np.concatenate([self.col_ub, np.full(n, INF)])
         return n
+
+    # -- subset-row cuts -------------------------------------------------------------------
+    def cut_coefficients(self, S, memory) -> np.ndarray:
+        """(n_routes,) limited-memory coefficient of every route."""
+        out = np.zeros(self.n_routes, dtype=np.int64)
+        pts = list(S)
+        for r in np.flatnonzero(self._visit[: self.n_routes][:, pts].sum(axis=1) >= 2):
+            out[r] = _lm_coefficient(self.routes[r], S, memory)
+        return out
+
+    def _memory(self, S, x) -> frozenset:
+        """S plus the points between visits to S on the LP's routes that visit S twice or more."""
+        mem = set(S)
+        for r in np.flatnonzero(x[: self.n_routes] > 1e-9):
+            route = self.routes[r]
+            at = [i for i, p in enumerate(route) if p in S]
+            if len(at) >= 2:
+                mem.update(route[at[0] : at[-1] + 1])
+        return frozenset(mem)
+
+    def separate_cuts(self, x: np.ndarray, max_new: int, min_violation: float = 0.05):
+        """Most violated subset-row cuts on triples for the LP solution x (routes); up to
+        ``max_new`` and :data:`MAX_CUTS` in all, each violated by at least ``min_violation``."""
+        room = min(max_new, MAX_CUTS - len(self.cuts))
+        k = self.n_routes
+        pos = np.flatnonzero(x[:k] > 1e-9)
+        if room <= 0 or pos.size == 0:
+            return []
+        vis = self._visit[pos].astype(np.int64)  # (routes, points)
+        xp = x[pos]
+        pts = np.flatnonzero(vis.sum(axis=0) > 0)
+        pts = pts[(pts > 0) & (pts <= self.V)]
+        have = set(self.cuts)
+        found = []
+        for a_i, a in enumerate(pts):
+            for b_i in range(a_i + 1, len(pts)):
+                b = pts[b_i]
+                ab = vis[:, a] + vis[:, b]
+                if not np.any(ab):
+                    continue
+                rest = pts[b_i + 1 :]
+                if rest.size == 0:
+                    continue
+                lhs = ((ab[:, None] + vis[:, rest]) // 2 * xp[:, None]).sum(axis=0)
+                for c in np.flatnonzero(lhs > 1.0 + min_violation):
+                    S = (int(a), int(b), int(rest[c]))
+                    if S not in have:
+                        found.append((float(lhs[c]), S))
+        found.sort(key=lambda t: -t[0])
+        chosen, used = [], {}
+        for _, S in found:  # spread the new cuts: a point in at most 3 of them per round
+            if any(used.get(p, 0) >= 3 for p in S):
+                continue
+            chosen.append((S, self._memory(S, x)))
+            for p in S:
+                used[p] = used.get(p, 0) + 1
+            if len(chosen) >= room:
+                break
+        return chosen
+
+    def add_cuts(self, cuts) -> int:
+        """Add subset-row cut rows ((triple, memory) of solver points) over all generated routes."""
+        cuts = [(tuple(S), frozenset(M)) for S, M in cuts if tuple(S) not in self.cuts]
+        cuts = cuts[: MAX_CUTS - len(self.cuts)]
+        if not cuts:
+            return 0
+        starts, idx, vals = [], [], []
+        art = self.n_art
+        for S, M in cuts:
+            a = self.cut_coefficients(S, M)
+            nz = np.flatnonzero(a)
+            starts.append(len(idx))
+            idx.extend((nz + art).tolist())
+            vals.extend(a[nz].astype(float).tolist())
+        n = len(cuts)
+        self.h.addRows(n, np.full(n, -INF), np.ones(n), len(idx), np.asarray(starts, np.int32),
+                       np.asarray(idx, np.int32), np.asarray(vals, dtype=float))
+        for S, M in cuts:
+            c = len(self.cuts)
+            bit = np.uint64(1) << np.uint64(c)
+            self.cuts.append(S)
+            self.memories.append(M)
+            for p in S:
+                self.cut_members[p] |= bit
+            for p in M:
+                self.cut_memory[p] |= bit
+        self.n_rows += n
+        self.row_lo = np.concatenate([self.row_lo, np.full(n, -INF)])
+        self.row_hi = np.concatenate([self.row_hi, np.ones(n)])
+        self.cur_lo = np.concatenate([self.cur_lo, np.full(n, -INF)])
+        return n
+
+    def cut_duals(self, y: np.ndarray) -> np.ndarray:
+        """Duals of the cut rows (>= 0, clipped), in cut order."""
+        return np.maximum(y[self.base_rows :], 0.0)
 
     # -- branching state -------------------------------------------------------------------
     def incompatible(self, state) -> np.ndarray:

@@ -147,8 +147,28 @@ def _completion(mask, v, room, need, order, profit, cin, reach, lastord, cend):
 
 
 @njit(cache=True)
+def _sigsum(bits, sig):
+    """Sum of the cut duals over the set bits of ``bits``; ``sig[k, b]`` is the sum over the
+    bits of byte value b in byte k (eight look-ups instead of a loop over 64 bits)."""
+    s = 0.0
+    for k in range(8):
+        b = (bits >> np.uint64(8 * k)) & np.uint64(255)
+        if b:
+            s += sig[k, b]
+    return s
+
+
+def _byte_sums(duals: np.ndarray) -> np.ndarray:
+    """(8, 256) table for :func:`_sigsum` from up to 64 cut duals."""
+    d = np.zeros(64)
+    d[: duals.size] = duals
+    bits = (np.arange(256)[:, None] >> np.arange(8)[None, :]) & 1  # (256, 8)
+    return np.ascontiguousarray(d.reshape(8, 8) @ bits.T)
+
+
+@njit(cache=True)
 def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
-           lastord, cend, threshold, deadline, half):
+           lastord, cend, threshold, deadline, half, cmem, mmem, sig):
     """Labelling from node 0 to node n-1.
 
     Returns (count, node, pred, energy, prize, mask, alive, hit_cap, threshold). Labels whose
@@ -156,6 +176,13 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
     energy <= ``half`` are extended (``half`` = budget for a one-way search). Labels are kept in
     creation order (global arrays, for the paths) and, for the dominance tests, in contiguous
     per-node buckets (energy, prize, mask, label id) so that the scans stay in cache.
+
+    Limited-memory subset-row cuts (``cmem[w]``: bitset of the cuts whose triple holds w;
+    ``mmem[w]``: of the cuts whose memory holds w, a superset; ``sig``: their duals, >= 0): a
+    label carries the parity of its visits to each cut's triple, forgotten on arrival at a point
+    outside the cut's memory; a visit that makes a pair pays the cut's dual. L1 dominates L2 only
+    if it still wins after paying the duals of the cuts where L1 holds an odd visit and L2 does
+    not (Jepsen et al. 2008; limited memory: Pecin et al. 2017).
     """
     n = cost.shape[0]
     end = n - 1
@@ -167,12 +194,14 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
     pr = np.empty(cap, np.float64)
     alive = np.empty(cap, np.bool_)
     mask = np.zeros((cap, W), np.uint64)
+    srb = np.zeros(cap, np.uint64)
     # per-node buckets of the alive labels
     bcnt = np.zeros(n, np.int64)
     ben = [np.empty(16, np.float64) for _ in range(n)]
     bpr = [np.empty(16, np.float64) for _ in range(n)]
     bid = [np.empty(16, np.int32) for _ in range(n)]
     bmask = [np.zeros((16, W), np.uint64) for _ in range(n)]
+    bsr = [np.zeros(16, np.uint64) for _ in range(n)]
     node[0] = 0
     pred[0] = -1
     en[0] = 0.0
@@ -212,6 +241,11 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             if mask[qi, wd] & wb:
                 continue
             p2 = pr[qi] + profit[w]
+            sq = srb[qi] & mmem[w]
+            hitc = sq & cmem[w]
+            if hitc:
+                p2 -= _sigsum(hitc, sig)
+            s2 = sq ^ cmem[w]
             for k in range(W):
                 newmask[k] = mask[qi, k] & ng[w, k]
             newmask[wd] |= wb
@@ -224,6 +258,7 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             wp = bpr[w]
             wi = bid[w]
             wm = bmask[w]
+            ws = bsr[w]
             cw = bcnt[w]
             j = 0
             while j < cw:
@@ -237,12 +272,17 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
                                 sub = False
                                 break
                     if sub:
+                        odd = ws[j] & ~s2
+                        if odd and pj - _sigsum(odd, sig) < p2 - EPS:
+                            sub = False
+                    if sub:
                         dominated = True
                         if j > 0:  # move the dominator forward: it is likely to dominate again
                             h = j >> 1
                             we[j], we[h] = we[h], we[j]
                             wp[j], wp[h] = wp[h], wp[j]
                             wi[j], wi[h] = wi[h], wi[j]
+                            ws[j], ws[h] = ws[h], ws[j]
                             for k in range(W):
                                 t = wm[j, k]
                                 wm[j, k] = wm[h, k]
@@ -256,11 +296,16 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
                                 sub = False
                                 break
                     if sub:
+                        odd = s2 & ~ws[j]
+                        if odd and p2 - _sigsum(odd, sig) < pj - EPS:
+                            sub = False
+                    if sub:
                         alive[wi[j]] = False
                         cw -= 1  # move the bucket's last label into slot j, examine it next
                         we[j] = we[cw]
                         wp[j] = wp[cw]
                         wi[j] = wi[cw]
+                        ws[j] = ws[cw]
                         for k in range(W):
                             wm[j, k] = wm[cw, k]
                         continue
@@ -285,6 +330,7 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
                 pr = _grow(pr, cap)
                 alive = _grow(alive, cap)
                 mask = _grow(mask, cap)
+                srb = _grow(srb, cap)
                 hkey = _grow(hkey, cap)
                 hval = _grow(hval, cap)
             node[count] = w
@@ -294,6 +340,7 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             if not heuristic and p2 > threshold and e2 + cost[w, end] <= budget:
                 threshold = p2  # exact mode looks for the best path: prune against the best found
             alive[count] = True
+            srb[count] = s2
             for k in range(W):
                 mask[count, k] = newmask[k]
             if cw == we.shape[0]:
@@ -302,6 +349,8 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
                 wp = _grow(wp, size)
                 wi = _grow(wi, size)
                 wm = _grow(wm, size)
+                ws = _grow(ws, size)
+                bsr[w] = ws
                 ben[w] = we
                 bpr[w] = wp
                 bid[w] = wi
@@ -309,6 +358,7 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             we[cw] = e2
             wp[cw] = p2
             wi[cw] = count
+            ws[cw] = s2
             for k in range(W):
                 wm[cw, k] = newmask[k]
             bcnt[w] = cw + 1
@@ -463,7 +513,7 @@ def _chain(node, pred, j):
 
 
 def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_cols, min_gain,
-          deadline=np.inf, bidirectional=False):
+          deadline=np.inf, bidirectional=False, cut_members=None, cut_memory=None, cut_duals=None):
     """Run the labelling; return a :class:`PricingResult`.
 
     ``profit`` holds the reduced prize of every point (0 at start and end); the value reported is
@@ -476,14 +526,35 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     then joined through one arc. Every path splits at its last arc leaving a forward prefix of
     energy <= budget/2; its suffix then has energy < budget/2, so both halves (or labels that
     dominate them) exist and their join is examined.
+
+    Subset-row cuts: ``cut_members[w]`` is the bitset of the (at most 64) cuts whose triple holds
+    point w, ``cut_memory[w]`` of those whose memory holds it (None: every cut remembers every
+    point), ``cut_duals`` their duals; a path's prize is then its reduced prize with the cuts'
+    duals paid. The join does not track cuts, so with cuts the search is one-way.
     """
     n = cost.shape[0]
+    if cut_members is None or cut_duals is None or not np.any(cut_duals > 0):
+        cmem = np.zeros(n, np.uint64)
+        mmem = np.zeros(n, np.uint64)
+        sig = np.zeros((8, 256))
+    else:
+        # only cuts with a positive dual change a path's value: the others are left out, so
+        # their parities neither split labels nor cost dominance tests
+        duals = np.asarray(cut_duals, dtype=np.float64)
+        active = np.uint64(0)
+        for c in np.flatnonzero(duals > 0):
+            active |= np.uint64(1) << np.uint64(c)
+        cmem = np.ascontiguousarray(np.asarray(cut_members, dtype=np.uint64) & active)
+        mmem = (np.full(n, np.uint64(0xFFFFFFFFFFFFFFFF), dtype=np.uint64) if cut_memory is None
+                else np.ascontiguousarray(cut_memory, dtype=np.uint64))
+        sig = _byte_sums(np.where(duals > 0, duals, 0.0))
+        bidirectional = False
     end = n - 1
     half = budget / 2.0 if bidirectional else budget
     order, cin, reach, lastord, cend = _prepare(cost, ret, profit, allowed)
     count, node, pred, en, pr, fmask, falive, hit, thr = _label(
         cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
-        lastord, cend, float(min_gain), float(deadline), half,
+        lastord, cend, float(min_gain), float(deadline), half, cmem, mmem, sig,
     )
     total = int(count)
     found = []  # (value, path)
@@ -501,7 +572,7 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
         order_b, cin_b, reach_b, lastord_b, cend_b = _prepare(cost_b, ret_b, profit_b, allowed_b)
         bcount, bnode, bpred, ben, bpr, bmask, balive, bhit, thr = _label(
             cost_b, ret_b, profit_b, budget, ng, allowed_b, heuristic, max_labels, order_b, cin_b,
-            reach_b, lastord_b, cend_b, float(thr), float(deadline), half,
+            reach_b, lastord_b, cend_b, float(thr), float(deadline), half, cmem[perm], mmem[perm], sig,
         )
         total += int(bcount)
         hit = hit or bhit
