@@ -59,3 +59,24 @@ def test_top_table_checks_against_published_optima():
     assert t.loc[1, "files"] == 3 and t.loc[1, "proven"] == 1 and t.loc[1, "wrong_optimal"] == 1
     assert t.loc[1, "bound_below_optimum"] == 2 and t.loc[1, "median_s_proven"] == 1.0
     assert t.loc[2, "proven"] == 0 and abs(t.loc[2, "bound_gap_unproven"] - 0.1) < 1e-12
+
+
+def test_long_bp_rows_join_the_paper_scale_gaps(tmp_path):
+    """paper-gaps-long's bp rows (other time limit, same instance ids) join paper-gaps as their
+    own method row, and their bounds count for the instances' gaps."""
+    import pandas as pd
+
+    root = tmp_path / "root"
+    common = 'methods = {m}\ntime_limit = 5\n[[instances]]\nM = 5\nK = 2\nN = 2\nruns = 2\n'
+    for name, methods in (("paper-gaps", '["greedy", "bp"]'), ("paper-gaps-long", '["bp"]')):
+        f = tmp_path / f"{name}.toml"
+        f.write_text(f'name = "{name}"\n' + common.format(m=methods))
+        run_suite(load_suite(str(f)), root / name, workers=1, progress=False)
+    text = write_reference(root, tmp_path / "out").read_text()
+    assert "paper-gaps-long" in text and "bp-300s" in text
+    runs = pd.read_csv(tmp_path / "out" / "runs_paper_gaps.csv")
+    assert set(runs["method"]) == {"greedy", "bp", "bp-300s"}
+    assert len(runs) == 6 and runs["instance"].nunique() == 2
+    long = runs[runs["method"] == "bp-300s"].set_index("instance")
+    best = runs.groupby("instance")["best_bound"].first()
+    assert (best <= long["bound"] + 1e-9).all()  # the best bound includes the long rows' bounds

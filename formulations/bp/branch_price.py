@@ -61,6 +61,16 @@ labelling on linked lists, no dive): 1 of 8 proven (pricing ~55 s of the root, e
 at 60 s (before: 100-119), incumbents 82 (heuristics such as pyvrp find 85-97: the bound is the
 useful output there; the root LP does not converge in 60 s on seeds 1-3). TOP sets 1-3: all 117
 published optima proven, the slowest p3.2.r in ~26 s, median under 0.1 s.
+
+Subset-row cuts (2026-12-01, same machine, the other core busy): on seed 5, the K = 3 instance
+that 60 s leaves open, 300 s without cuts end at 55 with bound 56 after 173 nodes; with cuts the
+root LP goes from 56.35 to 56.00 with 64 cuts and 55 is proven optimal after 4 nodes in 232 s
+(a second 300 s run, with fewer dives finishing, ended at bound 55 with incumbent 54). Pricing
+pays for them: one exact call at the root with 64 cuts took 19.6 s before the byte-table dual
+sums and the mask-first dominance test, 8.5 s after, 2.0 s with the cut duals zeroed (labels
+269k against 131k). At 60 s on seeds 0..7, cuts proved 5 of 8 against 7 of 8 without them (run
+side by side), and on a 30-viewpoint instance they turned a 2 s proof into 22 s: hence off below
+``CUTS_FROM_S``.
 """
 
 from __future__ import annotations
