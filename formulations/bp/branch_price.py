@@ -23,9 +23,8 @@ labelling pricing (:mod:`.pricing`):
 5. limited-memory subset-row cuts (:mod:`.master`), on by default for time limits of at least
    ``CUTS_FROM_S`` (120 s; ``cut_rounds`` = 0 turns them off, a number turns them on): at the
    root, once the floored bound is settled and the ng sets stop growing, up to ``cut_rounds``
-   (4) rounds of ``cuts_per_round``
-   (16) most violated triples (at most 64 in all), each followed by column generation with the
-   cut duals in the pricing. Cuts make every later pricing slower (labels carry cut parities and
+   (4) rounds of ``cuts_per_round`` (16) most violated triples (at most 64 in all), each
+   followed by column generation with the cut duals in the pricing. Cuts make every later pricing slower (labels carry cut parities and
    dominate less), so they are tried only within the first ``cut_share`` (35 %) of the time limit
    and only while the restricted LP is within ``cut_gap`` (half a prize step) of proving the
    incumbent or of lowering its own floor by one step.
@@ -584,7 +583,8 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
     info = {
         "nodes": st.nodes, "rounds": st.rounds, "columns": bp.master.n_routes,
         "exact_pricings": st.exact_pricings, "labels": st.labels, "ng_growths": st.ng_growths,
-        "milp_calls": st.milp_calls, "cuts": st.cuts, "root_lp": st.root_lp, "pricing_s": round(st.pricing_s, 3), "lp_s": round(st.lp_s, 3),
+        "milp_calls": st.milp_calls, "cuts": st.cuts, "root_lp": st.root_lp,
+        "pricing_s": round(st.pricing_s, 3), "lp_s": round(st.lp_s, 3),
         "root_bound": st.root_bound, "root_s": st.root_s, "history": st.history, "threads": 1,
         "bidirectional": bp.bidirectional, "mode_times": st.mode_times,
     }
