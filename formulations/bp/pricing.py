@@ -147,6 +147,81 @@ def _completion(mask, v, room, need, order, profit, cin, reach, lastord, cend):
 
 
 @njit(cache=True)
+def _suffix_dp(cost, profit, allowed, delta, nb):
+    """Suffix bounds by dynamic programming over energy units of ``delta`` (2-cycle-free paths).
+
+    ``g1[u, b]``: the most prize a path u -> ... -> end can collect after u (u's own prize not
+    counted) when its arc costs, each rounded down to whole units, sum to at most b units;
+    ``s1[u, b]`` its first successor; ``g2[u, b]`` the best whose first successor differs from
+    ``s1[u, b]``. Paths may repeat points but never turn straight back (u -> w -> u), so every
+    elementary suffix is among them; rounding each arc down only admits more paths: a label at
+    u, reached from v, with ``room`` energy left can add at most ``g1[u, room // delta]``
+    (``g2`` if ``s1`` is v). Unreachable: -inf.
+    """
+    n = cost.shape[0]
+    end = n - 1
+    g1 = np.full((n, nb + 1), -np.inf)
+    g2 = np.full((n, nb + 1), -np.inf)
+    s1 = np.full((n, nb + 1), -1, np.int32)
+    units = np.full((n, n), nb + 1, np.int64)
+    for u in range(n):
+        for w in range(n):
+            c = cost[u, w]
+            if u != w and c < np.inf:
+                q = int(c / delta)
+                if q < 1:
+                    q = 1  # not reached: delta <= the cheapest finite arc (checked by the caller)
+                if q <= nb:
+                    units[u, w] = q
+    for b in range(1, nb + 1):
+        for u in range(n - 1):
+            if u > 0 and not allowed[u]:
+                continue
+            best = -np.inf
+            bs = -1
+            second = -np.inf
+            if units[u, end] <= b:
+                best = 0.0
+                bs = end
+            for w in range(1, end):
+                if w == u or not allowed[w]:
+                    continue
+                q = units[u, w]
+                if q > b:
+                    continue
+                r = b - q
+                val = g1[w, r] if s1[w, r] != u else g2[w, r]
+                if val == -np.inf:
+                    continue
+                val += profit[w]
+                if val > best:
+                    second = best
+                    best = val
+                    bs = w
+                elif val > second:
+                    second = val
+            g1[u, b] = best
+            s1[u, b] = bs
+            g2[u, b] = second
+    return g1, s1, g2
+
+
+
+@njit(cache=True)
+def _dp_bound(g1, s1, g2, u, v, room, delta, nb):
+    """What a label at ``u`` reached from ``v`` with ``room`` energy left can still add, at most
+    (:func:`_suffix_dp`; +inf when the tables are disabled, ``nb`` = 0)."""
+    if nb == 0:
+        return np.inf
+    b = int((room + 1e-9 * (1.0 + abs(room))) / delta)  # never round a fitting suffix away
+    if b > nb:
+        b = nb
+    if b < 0:
+        return -np.inf
+    return g1[u, b] if s1[u, b] != v else g2[u, b]
+
+
+@njit(cache=True)
 def _sigsum(bits, sig):
     """Sum of the cut duals over the set bits of ``bits``; ``sig[k, b]`` is the sum over the
     bits of byte value b in byte k (eight look-ups instead of a loop over 64 bits)."""
@@ -168,7 +243,7 @@ def _byte_sums(duals: np.ndarray) -> np.ndarray:
 
 @njit(cache=True)
 def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
-           lastord, cend, threshold, deadline, half, cmem, mmem, sig):
+           lastord, cend, threshold, deadline, half, cmem, mmem, sig, g1, s1, g2, delta, nb):
     """Labelling from node 0 to node n-1.
 
     Returns (count, node, pred, energy, prize, mask, alive, hit_cap, threshold). Labels whose
@@ -226,6 +301,9 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
         if en[qi] > half:
             continue
         # the threshold may have risen since this label was stored
+        if pr[qi] + _dp_bound(g1, s1, g2, v, node[pred[qi]] if qi > 0 else -1, budget - en[qi],
+                              delta, nb) <= threshold:
+            continue
         if pr[qi] + _completion(mask[qi], v, budget - en[qi], threshold - pr[qi], order, profit,
                                 cin, reach, lastord, cend) <= threshold:
             continue
@@ -249,6 +327,8 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             for k in range(W):
                 newmask[k] = mask[qi, k] & ng[w, k]
             newmask[wd] |= wb
+            if p2 + _dp_bound(g1, s1, g2, w, v, budget - e2, delta, nb) <= threshold:
+                continue
             if p2 + _completion(newmask, w, budget - e2, threshold - p2, order, profit, cin, reach,
                                 lastord, cend) <= threshold:
                 continue
@@ -502,6 +582,33 @@ def _prepare(cost, ret, profit, allowed):
     return order, cin, reach, lastord, cend
 
 
+DP_UNITS = 512  # energy units of the suffix tables (budget / DP_UNITS each)
+DP_MAX_UNITS = 4096  # finer units needed (an arc cheaper than budget / 4096): tables off
+
+
+def suffix_tables(cost, profit, allowed, budget, units: int = DP_UNITS):
+    """Arguments ``g1, s1, g2, delta, nb`` of :func:`_label` for the suffix bound
+    (:func:`_suffix_dp`). The unit is budget / ``units``, or the cheapest arc between distinct
+    points (start -> end aside) if that is smaller, so that every arc costs at least one unit;
+    when that would take more than ``DP_MAX_UNITS`` units the tables are off (``nb`` = 0)."""
+    n = cost.shape[0]
+    off = np.isfinite(cost) & ~np.eye(n, dtype=bool)
+    off[0, n - 1] = off[n - 1, 0] = False
+    off[:, 0] = False
+    off[n - 1, :] = False
+    cheapest = float(cost[off].min()) if off.any() else np.inf
+    delta = float(budget) / units
+    if cheapest < delta:
+        delta = cheapest
+    if not (budget > 0 and delta > 0 and budget / delta <= DP_MAX_UNITS):
+        z = np.full((n, 1), np.inf)
+        return z, np.full((n, 1), -1, np.int32), z, 1.0, 0
+    nb = int(budget / delta) + 1
+    g1, s1, g2 = _suffix_dp(cost, np.ascontiguousarray(profit, dtype=np.float64), allowed,
+                            delta, nb)
+    return g1, s1, g2, delta, nb
+
+
 def _chain(node, pred, j):
     """Points of a label's path, from the root's successor to the label's point."""
     path = []
@@ -555,6 +662,7 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     count, node, pred, en, pr, fmask, falive, hit, thr = _label(
         cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
         lastord, cend, float(min_gain), float(deadline), half, cmem, mmem, sig,
+        *suffix_tables(cost, profit, allowed, budget),
     )
     total = int(count)
     found = []  # (value, path)
@@ -573,6 +681,7 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
         bcount, bnode, bpred, ben, bpr, bmask, balive, bhit, thr = _label(
             cost_b, ret_b, profit_b, budget, ng, allowed_b, heuristic, max_labels, order_b, cin_b,
             reach_b, lastord_b, cend_b, float(thr), float(deadline), half, cmem[perm], mmem[perm], sig,
+            *suffix_tables(cost_b, profit_b, allowed_b, budget),
         )
         total += int(bcount)
         hit = hit or bhit
