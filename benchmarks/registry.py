@@ -59,7 +59,7 @@ _SPECS = [
                "time-flow TOP MILP on HiGHS via Pyomo: pruned arcs, cliques, path + connectivity cuts, 1 thread, gap 0"),
     MethodSpec("bp", "heuristics.bp_warm:bp", True,
                "branch-and-price: route master on HiGHS, ng-route labelling pricing (numba), greedy's routes "
-               "as first columns, 1 thread"),
+               "as first columns, PyVRP as primal heuristic once the root leaves the proof open, 1 thread"),
 ]
 
 METHODS: dict[str, MethodSpec] = {spec.name: spec for spec in _SPECS}

@@ -14,7 +14,7 @@ from formulations.bp import solve_bp
 from formulations.instance import TOPInstance
 from formulations.io import load_instance
 from formulations.plan import Status
-from formulations.verify import route_energy
+from formulations.verify import route_energy, verify
 
 TOP_DIR = Path(__file__).resolve().parent.parent / "benchmarks" / "instances" / "top"
 OPTIMAL = {r["instance"]: float(r["value"]) for r in csv.DictReader(open(TOP_DIR / "optimal.csv"))}
@@ -385,6 +385,72 @@ def test_registered_bp_starts_from_greedy():
     assert r.info["warm_start_prize"] == g.objective
 
 
+def _top(name):
+    return load_instance(TOP_DIR / f"{name}.txt")
+
+
+def _prize(inst, result):
+    rep = verify(inst, result.plan)
+    assert rep.valid
+    return rep.prize
+
+
+def test_primal_plan_becomes_the_incumbent_when_the_root_needs_it():
+    """``primal`` runs once, after the root and its first dive leave the proof open (p1.2.l);
+    a verified plan it returns is taken as incumbent and its routes as columns; the run still
+    proves the published optimum."""
+    inst = _top("p1.2.l")
+    ref = solve_bp(inst, time_limit=30)
+    assert ref.status == Status.OPTIMAL
+    calls = []
+
+    def primal(seconds):
+        calls.append(seconds)
+        return [list(r) for r in ref.plan.routes]
+
+    r = solve_bp(inst, time_limit=60, primal=primal)
+    assert len(calls) == 1 and 0 < calls[0] <= 0.1 * 60 + 1e-9
+    assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p1.2.l"])
+    assert r.info["primal_prize"] == pytest.approx(OPTIMAL["p1.2.l"])
+    assert r.info["primal_s"] is not None and r.info["primal_error"] is None
+
+
+def test_primal_is_not_run_when_the_root_proves():
+    calls = []
+    inst = _top("p1.2.a")
+    r = solve_bp(inst, time_limit=30, primal=lambda s: calls.append(s))
+    assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p1.2.a"])
+    assert calls == [] and r.info["primal_s"] is None
+
+
+@pytest.mark.parametrize("kind", ["raises", "over-budget", "empty"])
+def test_a_bad_primal_costs_nothing_but_its_time(kind):
+    """A failing heuristic, one returning a plan the verifier rejects, or none at all: the run
+    goes on and proves the optimum; the rejected plan is never the incumbent."""
+    inst = _top("p1.2.l")
+
+    def primal(seconds):
+        if kind == "raises":
+            raise RuntimeError("boom")
+        if kind == "over-budget":
+            return [list(range(inst.n_nodes))]  # every node in one route: far over the budget
+        return None
+
+    r = solve_bp(inst, time_limit=60, primal=primal)
+    assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p1.2.l"])
+    assert r.info["primal_s"] is not None and r.info["primal_prize"] is None
+    assert (r.info["primal_error"] == "RuntimeError: boom") == (kind == "raises")
+
+
+def test_registered_bp_runs_pyvrp_as_its_primal():
+    """The registered `bp` hands PyVRP to the search: on an instance the root leaves open its
+    plan is verified and counted (p1.2.l)."""
+    r, rep = run_method("bp", _top("p1.2.l"), time_limit=60)
+    assert rep.valid and r.status == Status.OPTIMAL
+    assert r.info["primal_prize"] is not None and r.info["primal_prize"] <= r.objective + 1e-9
+    assert r.info["primal_error"] is None
+
+
 # -- limited-memory subset-row cuts ------------------------------------------------------------
 
 def test_lm_coefficient_counts_pairs_and_forgets_outside_memory():
@@ -483,6 +549,42 @@ def test_master_cut_rows_hold_lm_coefficients():
     # memory {1, 2, 3}: (1, 4, 2) forgets 1 at 4 and pays nothing, so the LP uses it at 1/2
     assert got[(1, 4, 2)] == 0 and value == pytest.approx(4.5)
     assert m.cut_duals(y).shape == (1,)
+
+
+def test_purged_cuts_leave_the_lp_and_free_their_bits():
+    """Purging drops exactly the cuts of zero dual: same LP value, the rows and bitsets of the
+    kept cuts renumbered, and routes and cuts added afterwards get the right coefficients."""
+    from formulations.bp.master import Master, _lm_coefficient
+
+    m = Master(6, np.ones(6), [], 6)
+    m.add_routes([(1, 2), (2, 3), (1, 3), (4,), (5,), (6,)])
+    idle = ((4, 5, 6), frozenset({4, 5, 6}))  # no route visits two of them: zero dual
+    assert m.add_cuts([idle, ((1, 2, 3), frozenset({1, 2, 3}))]) == 2
+    value, _, _, y = m.solve()
+    assert value == pytest.approx(5.0)  # one route of the triangle + the three singles
+    assert m.cut_duals(y)[0] == 0 and m.cut_duals(y)[1] > 0
+    assert m.purge_cuts(y) == 1
+    assert m.cuts == [(1, 2, 3)] and m.n_rows == m.base_rows + 1
+    assert m.h.getNumRow() == m.n_rows and len(m.row_lo) == len(m.row_hi) == m.n_rows
+    assert [int(b) for b in m.cut_members[1:7]] == [1, 1, 1, 0, 0, 0]
+    assert m.solve()[0] == pytest.approx(value)
+    m.add_routes([(1, 2, 3)])  # pays 1 in the kept cut's row (now row base_rows)
+    a = m.h.getLp().a_matrix_
+    col = m.n_art + m.n_routes - 1
+    coef = dict(zip(a.index_[a.start_[col] : a.start_[col + 1]], a.value_[a.start_[col] : a.start_[col + 1]]))
+    assert coef.get(m.base_rows) == _lm_coefficient((1, 2, 3), (1, 2, 3), m.memories[0]) == 1
+    assert m.solve()[0] == pytest.approx(6.0)
+    assert m.add_cuts([idle]) == 1 and int(m.cut_members[4]) == 2  # the next free bit
+
+
+def test_purging_cuts_keeps_the_published_optimum():
+    """Rounds of 48 cuts on p2.2.k pass the 64-cut limit, so idle cuts are purged between
+    rounds; the published optimum is still proven."""
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    r = solve_bp(inst, time_limit=60, cut_rounds=4, cuts_per_round=48, cut_gap=100.0, cut_share=1.0)
+    assert r.info["cuts_purged"] > 0
+    assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p2.2.k"])
+    assert r.bound == pytest.approx(OPTIMAL["p2.2.k"])
 
 
 @pytest.mark.parametrize("name", ["p1.3.n", "p3.3.k", "p2.2.k"])

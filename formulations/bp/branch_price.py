@@ -23,11 +23,12 @@ labelling pricing (:mod:`.pricing`):
 5. limited-memory subset-row cuts (:mod:`.master`), on by default for time limits of at least
    ``CUTS_FROM_S`` (120 s; ``cut_rounds`` = 0 turns them off, a number turns them on): at the
    root, once the floored bound is settled and the ng sets stop growing, up to ``cut_rounds``
-   (4) rounds of ``cuts_per_round`` (16) most violated triples (at most 64 in all), each
-   followed by column generation with the cut duals in the pricing. Cuts make every later pricing slower (labels carry cut parities and
-   dominate less), so they are tried only within the first ``cut_share`` (35 %) of the time limit
-   and only while the restricted LP is within ``cut_gap`` (half a prize step) of proving the
-   incumbent or of lowering its own floor by one step.
+   (6) rounds of ``cuts_per_round`` (16) most violated triples, each followed by column
+   generation with the cut duals in the pricing. At most 64 cuts at a time: when a round would
+   pass that, the cuts of zero dual are removed first. Cuts make every later pricing slower
+   (labels carry cut parities and dominate less), so they are tried only within the first
+   ``cut_share`` (35 %) of the time limit and only while the restricted LP is within ``cut_gap``
+   (half a prize step) of proving the incumbent or of lowering its own floor by one step.
 
 Branching, in order: on a fractional node visit (forbid the node / force it visited: a forced node
 row becomes ``= 1``); then, when all visits are integral, on a fractional arc flow (forbid the arc
@@ -35,7 +36,8 @@ row becomes ``= 1``); then, when all visits are integral, on a fractional arc fl
 Both keep the pricing a plain labelling on a modified graph. With integral visits and arc flows an
 LP solution of elementary routes is integral (each positive route follows the unique flow-1 arcs);
 a node where that still fails (repeated routes) stays unresolved and the run is not reported
-proven. Nodes are explored best-bound first; a node is pruned when its floored bound does not
+proven. Nodes are explored best floored bound first, deepest first among equals (depth first
+until a plan of the best floored value turns up); a node is pruned when its floored bound does not
 exceed the incumbent.
 
 Incumbents: dives (fix the route of largest LP value by forcing its nodes and arcs, re-price
@@ -81,7 +83,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from formulations.bp.master import Master
+from formulations.bp.master import MAX_CUTS, Master
 from formulations.bp.pricing import (add_to_ng, cheapest_return, full_ng, nearest_ng, price,
                                      warm_up)
 from formulations.instance import TOPInstance, precheck
@@ -90,6 +92,8 @@ from formulations.verify import verify
 
 TOL = 1e-6
 CUTS_FROM_S = 120.0  # time limits from which subset-row cuts are on by default
+PRIMAL_SHARE = 0.1  # of the time limit for the caller's heuristic (``primal``) ...
+PRIMAL_CAP_S = 10.0  # ... but at most this many seconds
 
 
 @dataclass(frozen=True)
@@ -116,7 +120,16 @@ class _Stats:
     ng_growths: int = 0
     nodes: int = 0
     milp_calls: int = 0
+    milp_s: float = 0.0
+    milp_improved: int = 0  # MILP calls that raised the incumbent
+    dives: int = 0
+    dive_improved: int = 0  # dives that raised the incumbent
+    primal_s: float | None = None  # the caller's heuristic: time, its plan's prize, improved?
+    primal_prize: float | None = None
+    primal_improved: bool | None = None
+    primal_error: str | None = None
     cuts: int = 0
+    cuts_purged: int = 0
     root_lp: float | None = None  # restricted root LP value when cuts were first considered
     pricing_s: float = 0.0
     lp_s: float = 0.0
@@ -130,10 +143,12 @@ class BranchAndPrice:
     def __init__(self, instance: TOPInstance, *, time_limit: float | None, ng_size: int = 8,
                  initial_routes=None, bidirectional: bool | None = None, ng_columns: bool = True,
                  ng_cap: int = 12, grow_share: float = 0.3, cut_rounds: int | None = None,
-                 cuts_per_round: int = 16, cut_gap: float = 0.5, cut_share: float = 0.35):
+                 cuts_per_round: int = 16, cut_gap: float = 0.5, cut_share: float = 0.35,
+                 primal=None, primal_share: float = PRIMAL_SHARE):
+        self.primal = primal
         if cut_rounds is None:  # auto: cuts only pay back their slower pricing on long runs
             long_run = time_limit is None or float(time_limit) >= CUTS_FROM_S
-            cut_rounds = 4 if long_run else 0
+            cut_rounds = 6 if long_run else 0
         self.cut_rounds = cut_rounds
         self.cut_gap = cut_gap
         self.cuts_per_round = cuts_per_round
@@ -145,6 +160,7 @@ class BranchAndPrice:
         self.t0 = time.perf_counter()
         limit = float(time_limit) if time_limit is not None else math.inf
         self.dive_limit = 0.1 * limit if math.isfinite(limit) else 30.0
+        self.primal_limit = min(primal_share * limit, PRIMAL_CAP_S)
         self.dived = False
         self.dive_starts: set[int] = set()  # first route fixed by each dive so far
         self.grow_until = self.t0 + (grow_share * limit if math.isfinite(limit) else math.inf)
@@ -371,18 +387,23 @@ class BranchAndPrice:
                 # (which only pays when the incumbent is below the floored bound)
                 self.dived = True
                 self.dive(min(self.dive_limit, 0.5 * self._time_left()))
+                if not self._prunable(bound) and self.primal is not None:
+                    self._call_primal()
+                    if not self._prunable(bound):  # dive again, now with the heuristic's columns
+                        m.apply(state)
+                        self.dive(min(self.dive_limit, 0.5 * self._time_left()))
                 m.apply(state)
                 if self._prunable(bound):
                     return bound, x, xa, True
-                continue  # re-solve with the dive's columns
+                continue  # re-solve with the heuristic's and the dive's columns
             if self._grow_ng_from_lp(x):
                 m.apply(state)
                 continue
-            if self._add_cuts(state, x, value):
+            if self._add_cuts(state, x, y, value):
                 continue
             return bound, x, xa, True
 
-    def _add_cuts(self, state: NodeState, x, lp_value: float) -> bool:
+    def _add_cuts(self, state: NodeState, x, y, lp_value: float) -> bool:
         """Subset-row cuts on triples violated by the node's LP solution; report whether any was
         added. Cuts make every later pricing slower (labels pay their duals and dominate less),
         so they are only tried at the root, within the first ``cut_share`` of the time limit,
@@ -400,12 +421,40 @@ class BranchAndPrice:
         if need > self.cut_gap * self.step:
             return False
         self.cut_round += 1
+        if len(self.master.cuts) + self.cuts_per_round > MAX_CUTS:  # make room: drop idle cuts
+            self.stats.cuts_purged += self.master.purge_cuts(y)
         cuts = self.master.separate_cuts(x, self.cuts_per_round)
         added = self.master.add_cuts(cuts)
         self.stats.cuts += added
         return added > 0
 
-    # -- primal heuristic ------------------------------------------------------------------
+    # -- primal heuristics -----------------------------------------------------------------
+    def _call_primal(self) -> None:
+        """Run the caller's heuristic (``primal``) once, with ``primal_share`` of the time limit
+        (at most ``PRIMAL_CAP_S``): its plan becomes columns and, if the verifier passes it and
+        it is better, the incumbent. Called when the root's floored bound is settled and the
+        first dive has not found a plan that proves it, so instances the root or its first dive
+        settle (most TOP instances) never pay for it."""
+        if self.primal is None or self._time_left() <= 0:
+            return
+        t = time.perf_counter()
+        allowance = min(self.primal_limit, 0.5 * self._time_left())
+        try:
+            routes = self.primal(allowance)
+        except Exception as exc:  # a failing heuristic must not cost the proof search
+            self.stats.primal_error = f"{type(exc).__name__}: {exc}"
+            routes = None
+        self.stats.primal_s = round(time.perf_counter() - t, 3)
+        if not routes:
+            return
+        pts = [tuple(int(v) + 1 for v in r) for r in routes if len(r)]
+        rep = verify(self.inst, Plan.of([[p - 1 for p in r] for r in pts]))
+        self.stats.primal_prize = float(rep.prize) if rep.valid else None
+        before = self.incumbent_value
+        self._offer(pts)
+        self.stats.primal_improved = self.incumbent_value > before
+        self.master.add_routes([r for r in pts if self._energy(r) <= self.budget])
+
     def dive(self, limit: float, start: NodeState | None = None) -> None:
         """Diving: fix the route of largest LP value (its nodes and arcs forced), re-solve the
         LP with heuristic pricing only, repeat until the LP solution is integral. A fixing that
@@ -413,10 +462,13 @@ class BranchAndPrice:
         nothing; feeds incumbents and columns (routes that fit together) to the MILP."""
         m = self.master
         m.hide_repeated = True  # plans are made of elementary routes: ng-routes would only mislead
+        before = self.incumbent_value
         try:
             self._dive(limit, start)
         finally:
             m.hide_repeated = False
+        self.stats.dives += 1
+        self.stats.dive_improved += self.incumbent_value > before
 
     def _dive(self, limit: float, start: NodeState | None) -> None:
         m = self.master
@@ -478,16 +530,25 @@ class BranchAndPrice:
             return None
         return [state.child(forced_arcs=[arc]), state.child(forbidden_arcs=[arc])]
 
+    def _node_key(self, bound: float, depth: int, counter: int, state: NodeState):
+        """Heap entry: best floored bound first, then deepest. Pruning only looks at floored
+        bounds, so every open node of the best floor must be solved unless a plan of that value
+        turns up; among them, depth first reaches integral LP solutions (plans) sooner."""
+        return (-self._floor(bound), -depth, -bound, counter, state)
+
     def _run_milp(self, limit: float) -> None:
         self.stats.milp_calls += 1
         limit = min(limit, max(0.0, self.hard_deadline - time.perf_counter() - 0.1))
         if limit > 0.05:
+            t, before = time.perf_counter(), self.incumbent_value
             self._offer(self.master.milp(limit))
+            self.stats.milp_s += time.perf_counter() - t
+            self.stats.milp_improved += self.incumbent_value > before
 
     def run(self):
         root = NodeState()
         trivial = float(self.inst.prizes[self.reachable[1 : self.V + 1]].sum())
-        heap = [(-trivial, 0, 0, root)]
+        heap = [self._node_key(trivial, 0, 0, root)]
         counter = 1
         open_bound = math.inf
         unresolved = []  # nodes we cannot split further (should not happen) with their bounds
@@ -496,7 +557,7 @@ class BranchAndPrice:
         while heap:
             if self._time_left() <= 0:
                 break
-            negb, _, _, state = heapq.heappop(heap)
+            _, _, negb, _, state = heapq.heappop(heap)
             parent_bound = -negb
             if self._prunable(parent_bound):
                 continue
@@ -515,7 +576,7 @@ class BranchAndPrice:
                     self._run_milp(min(10.0, 0.25 * self._time_left()))
                     last_milp_cols = self.master.n_routes
             if not converged:
-                heapq.heappush(heap, (-bound, -state.depth, counter, state))
+                heapq.heappush(heap, self._node_key(bound, state.depth, counter, state))
                 counter += 1
                 break
             if self._prunable(bound):
@@ -535,7 +596,7 @@ class BranchAndPrice:
                 unresolved.append(bound)
                 continue
             for ch in children:
-                heapq.heappush(heap, (-bound, -ch.depth, counter, ch))
+                heapq.heappush(heap, self._node_key(bound, ch.depth, counter, ch))
                 counter += 1
             if self.stats.nodes % 10 == 0 and self.master.n_routes > last_milp_cols:
                 self._run_milp(min(5.0, 0.1 * max(self._time_left(), 0.0)))
@@ -544,7 +605,7 @@ class BranchAndPrice:
             proven = not unresolved
         if not proven and self.master.n_routes:
             self._run_milp(max(0.0, self.hard_deadline - time.perf_counter() - 0.1))
-        open_bounds = [-nb for nb, *_ in heap] + unresolved
+        open_bounds = [-item[2] for item in heap] + unresolved
         inc = self.incumbent_value if self.incumbent is not None else -math.inf
         if open_bounds:
             open_bound = max(self._floor(b) for b in open_bounds)
@@ -560,11 +621,13 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
              initial_routes=None, ng_size: int = 8, bidirectional: bool | None = None,
              ng_columns: bool = True, ng_cap: int = 12, grow_share: float = 0.3,
              cut_rounds: int | None = None, cuts_per_round: int = 16, cut_gap: float = 0.5,
-             cut_share: float = 0.35) -> Result:
+             cut_share: float = 0.35, primal=None, primal_share: float = PRIMAL_SHARE) -> Result:
     """Branch-and-price: proven optimum, or the best plan and a certified bound at the limit.
 
     ``initial_routes`` (node ids, e.g. a heuristic plan's routes) are added as starting columns
-    and as a first incumbent. ``bidirectional``: exact pricing direction; None picks the faster
+    and as a first incumbent. ``primal(seconds) -> routes or None`` (node ids) is a heuristic
+    run once if the root does not settle the proof, with ``primal_share`` of the time limit (at
+    most ``PRIMAL_CAP_S``); its routes become columns and, if verified and better, the incumbent. ``bidirectional``: exact pricing direction; None picks the faster
     one on the first exact pricing call. ``seed`` is unused (no randomness; timing-based choices
     and the time limit can still change the path taken).
     """
@@ -577,13 +640,17 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
                         initial_routes=initial_routes, bidirectional=bidirectional,
                         ng_columns=ng_columns, ng_cap=ng_cap, grow_share=grow_share,
                         cut_rounds=cut_rounds, cuts_per_round=cuts_per_round, cut_gap=cut_gap,
-                        cut_share=cut_share)
+                        cut_share=cut_share, primal=primal, primal_share=primal_share)
     proven, bound = bp.run()
     st = bp.stats
     info = {
         "nodes": st.nodes, "rounds": st.rounds, "columns": bp.master.n_routes,
         "exact_pricings": st.exact_pricings, "labels": st.labels, "ng_growths": st.ng_growths,
-        "milp_calls": st.milp_calls, "cuts": st.cuts, "root_lp": st.root_lp,
+        "milp_calls": st.milp_calls, "milp_s": round(st.milp_s, 3),
+        "milp_improved": st.milp_improved, "dives": st.dives, "dive_improved": st.dive_improved,
+        "cuts": st.cuts, "cuts_purged": st.cuts_purged,
+        "root_lp": st.root_lp, "primal_s": st.primal_s, "primal_prize": st.primal_prize,
+        "primal_improved": st.primal_improved, "primal_error": st.primal_error,
         "pricing_s": round(st.pricing_s, 3), "lp_s": round(st.lp_s, 3),
         "root_bound": st.root_bound, "root_s": st.root_s, "history": st.history, "threads": 1,
         "bidirectional": bp.bidirectional, "mode_times": st.mode_times,

@@ -13,8 +13,9 @@ once. Limited memory (Pecin, Pessoa, Poggi & Uchoa 2017): each cut has a memory 
 along a route, an unpaired visit to S is forgotten at a point outside M, and ``a_Sr`` counts the
 pairs made (repeated visits of an ng-route included, as the pricing counts them). That is at most
 floor(visits to S / 2), so the cut stays valid; M is chosen from the LP routes that violate the
-full cut, so that the separated violation is kept. At most :data:`MAX_CUTS` (one 64-bit word in
-the labels).
+full cut, so that the separated violation is kept. At most :data:`MAX_CUTS` at a time (one
+64-bit word in the labels); cuts whose dual is zero can be removed to make room
+(:meth:`Master.purge_cuts`).
 
 The group row counts visits (a route through two nodes of one group counts 2). For integer x this
 is the same constraint as "some chosen route covers g" because each node is visited at most once
@@ -270,6 +271,36 @@ class Master:
         self.row_hi = np.concatenate([self.row_hi, np.ones(n)])
         self.cur_lo = np.concatenate([self.cur_lo, np.full(n, -INF)])
         return n
+
+    def purge_cuts(self, y: np.ndarray, tol: float = 1e-9) -> int:
+        """Remove the cut rows whose dual in ``y`` is zero (their slots are then free for new
+        cuts; the pricing ignores them anyway); return how many. Cuts are valid for every plan,
+        so dropping some only weakens the LP, and one of zero dual leaves the LP optimum as is."""
+        if not self.cuts:
+            return 0
+        duals = self.cut_duals(y)
+        drop = np.flatnonzero(duals <= tol)
+        if drop.size == 0:
+            return 0
+        rows = (drop + self.base_rows).astype(np.int32)
+        self.h.deleteRows(int(rows.size), rows)
+        keep_row = np.ones(self.n_rows, dtype=bool)
+        keep_row[rows] = False
+        self.row_lo, self.row_hi, self.cur_lo = (a[keep_row] for a in (self.row_lo, self.row_hi,
+                                                                      self.cur_lo))
+        self.n_rows -= int(rows.size)
+        kept = [c for c in range(len(self.cuts)) if duals[c] > tol]
+        self.cuts = [self.cuts[c] for c in kept]
+        self.memories = [self.memories[c] for c in kept]
+        self.cut_members[:] = 0
+        self.cut_memory[:] = 0
+        for c, (S, M) in enumerate(zip(self.cuts, self.memories)):
+            bit = np.uint64(1) << np.uint64(c)
+            for p in S:
+                self.cut_members[p] |= bit
+            for p in M:
+                self.cut_memory[p] |= bit
+        return int(drop.size)
 
     def cut_duals(self, y: np.ndarray) -> np.ndarray:
         """Duals of the cut rows (>= 0, clipped), in cut order."""
