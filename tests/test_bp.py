@@ -451,6 +451,32 @@ def test_registered_bp_runs_pyvrp_as_its_primal():
     assert r.info["primal_error"] is None
 
 
+@pytest.mark.parametrize("name", ["p1.2.l", "p2.2.k", "p3.2.f"])
+def test_milp_column_filter_keeps_every_better_plan(name):
+    """The reduced-cost filter of the MILP's columns (duals that certified the root bound)
+    never removes a better plan: with the incumbent set below the best plan over the generated
+    routes, the filtered MILP finds a plan of that same value, from fewer routes."""
+    from formulations.bp.branch_price import BranchAndPrice, NodeState
+
+    inst = _top(name)
+    bp = BranchAndPrice(inst, time_limit=30)
+    bp.column_generation(NodeState(), np.inf)
+    assert bp.root_cert is not None
+    full = bp.master.milp(20.0)
+    best = sum(bp.master.route_prize[bp.master.routes.index(r)] for r in full)
+    for below in (bp.step, 2 * bp.step, 4 * bp.step):
+        bp.incumbent, bp.incumbent_value = [], best - below
+        keep = bp._milp_columns()
+        assert keep is not None and keep.sum() <= bp.master.n_routes
+        got = bp.master.milp(20.0, keep)
+        assert got is not None
+        assert sum(bp.master.route_prize[bp.master.routes.index(r)] for r in got) == pytest.approx(best)
+    bp.incumbent_value = best  # nothing better among these routes: the filter may keep none,
+    keep = bp._milp_columns()  # and whatever it keeps cannot beat the incumbent by a step
+    sub = bp.master.milp(20.0, keep) if keep.any() else []
+    assert sum(bp.master.route_prize[bp.master.routes.index(r)] for r in sub or []) <= best + 1e-9
+
+
 # -- limited-memory subset-row cuts ------------------------------------------------------------
 
 def test_lm_coefficient_counts_pairs_and_forgets_outside_memory():

@@ -125,6 +125,7 @@ class _Stats:
     milp_calls: int = 0
     milp_s: float = 0.0
     milp_improved: int = 0  # MILP calls that raised the incumbent
+    milp_columns: int | None = None  # routes the last MILP could use (reduced-cost filter)
     dives: int = 0
     dive_improved: int = 0  # dives that raised the incumbent
     primal_s: float | None = None  # the caller's heuristic: time, its plan's prize, improved?
@@ -149,6 +150,7 @@ class BranchAndPrice:
                  cuts_per_round: int = 16, cut_gap: float = 0.5, cut_share: float = 0.35,
                  primal=None, primal_share: float = PRIMAL_SHARE):
         self.primal = primal
+        self.root_cert = None  # (duals, their dual term, best reduced prize bound, bound)
         if cut_rounds is None:  # auto: cuts only pay back their slower pricing on long runs
             long_run = time_limit is None or float(time_limit) >= CUTS_FROM_S
             cut_rounds = 6 if long_run else 0
@@ -369,7 +371,12 @@ class BranchAndPrice:
             res = self._exact_price(cost, ret, prof, allowed, gain, sig)
             self.stats.exact_pricings += 1
             if res.exact:
-                bound = min(bound, m.lagrangian_bound(y, res.best))
+                lag = m.lagrangian_bound(y, res.best)
+                if state.depth == 0 and (self.root_cert is None or lag < self.root_cert[3]):
+                    # duals that certify the root bound: they also filter the MILP's columns
+                    self.root_cert = (y.copy(), m.lagrangian_bound(y, y0),
+                                      max(0.0, res.best - y0), lag)
+                bound = min(bound, lag)
                 if state.depth == 0:
                     self._log(bound)
                 if self._prunable(bound):
@@ -425,7 +432,10 @@ class BranchAndPrice:
             return False
         self.cut_round += 1
         if len(self.master.cuts) + self.cuts_per_round > MAX_CUTS:  # make room: drop idle cuts
-            self.stats.cuts_purged += self.master.purge_cuts(y)
+            purged = self.master.purge_cuts(y)
+            self.stats.cuts_purged += purged
+            if purged:
+                self.root_cert = None  # its duals refer to rows that are gone
         cuts = self.master.separate_cuts(x, self.cuts_per_round)
         added = self.master.add_cuts(cuts)
         self.stats.cuts += added
@@ -541,12 +551,29 @@ class BranchAndPrice:
         turns up; among them, depth first reaches integral LP solutions (plans) sooner."""
         return (-self._floor(bound), -depth, -bound, counter, state)
 
+    def _milp_columns(self):
+        """Routes that can be part of a plan better than the incumbent, by reduced cost under
+        the duals y that certified the root bound: a plan of elementary routes (at most N)
+        containing route k is worth at most dual_term(y) + rc_k + (N-1)·rc*, where rc* bounds
+        every route's reduced prize (the exact pricing's value). None: no filter."""
+        if self.root_cert is None or self.incumbent is None:
+            return None
+        y, dual_term, rc_star, _ = self.root_cert
+        need = self.incumbent_value + (self.step if self.integral else 1e-9)
+        rc = self.master.reduced_costs(y)
+        return rc >= need - dual_term - (self.N - 1) * rc_star - 1e-6
+
     def _run_milp(self, limit: float) -> None:
         self.stats.milp_calls += 1
         limit = min(limit, max(0.0, self.hard_deadline - time.perf_counter() - 0.1))
         if limit > 0.05:
             t, before = time.perf_counter(), self.incumbent_value
-            self._offer(self.master.milp(limit))
+            allowed = self._milp_columns()
+            if allowed is not None:
+                self.stats.milp_columns = int(allowed.sum())
+                if not allowed.any():
+                    return  # no generated route can be part of a better plan
+            self._offer(self.master.milp(limit, allowed))
             self.stats.milp_s += time.perf_counter() - t
             self.stats.milp_improved += self.incumbent_value > before
 
@@ -652,7 +679,7 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
         "nodes": st.nodes, "rounds": st.rounds, "columns": bp.master.n_routes,
         "exact_pricings": st.exact_pricings, "labels": st.labels, "ng_growths": st.ng_growths,
         "milp_calls": st.milp_calls, "milp_s": round(st.milp_s, 3),
-        "milp_improved": st.milp_improved, "dives": st.dives, "dive_improved": st.dive_improved,
+        "milp_improved": st.milp_improved, "milp_columns": st.milp_columns, "dives": st.dives, "dive_improved": st.dive_improved,
         "cuts": st.cuts, "cuts_purged": st.cuts_purged,
         "root_lp": st.root_lp, "primal_s": st.primal_s, "primal_prize": st.primal_prize,
         "primal_improved": st.primal_improved, "primal_error": st.primal_error,

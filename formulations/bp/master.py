@@ -401,6 +401,24 @@ class Master:
         rc_star = max(0.0, best_path_prize - y[0])
         return float(term.sum() + self.N * rc_star)
 
+    def reduced_costs(self, y: np.ndarray) -> np.ndarray:
+        """(n_routes,) reduced prize p_r - A_r·y of every route for duals ``y``; rows added after
+        ``y`` was read (cuts) count with dual 0."""
+        k = self.n_routes
+        if k == 0:
+            return np.zeros(0)
+        yy = np.zeros(self.n_rows)
+        yy[: min(len(y), self.n_rows)] = y[: self.n_rows]
+        a = self.h.getLp().a_matrix_
+        starts = np.asarray(a.start_, dtype=np.int64)[self.n_art : self.n_art + k + 1]
+        index = np.asarray(a.index_, dtype=np.int64)[starts[0] : starts[-1]]
+        value = np.asarray(a.value_)[starts[0] : starts[-1]]
+        terms = value * yy[index]
+        lens = np.diff(starts)
+        at = np.repeat(np.arange(k), lens)
+        used = np.bincount(at, weights=terms, minlength=k)
+        return np.asarray(self.route_prize) - used
+
     def node_visits(self, x: np.ndarray) -> np.ndarray:
         """(V+2,) visit value of each point in an LP solution."""
         k = self.n_routes
