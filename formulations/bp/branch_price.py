@@ -56,25 +56,29 @@ finds the optimum on 5 of the 8 seeds.
 The reported bound is max(incumbent, floored bounds of the open nodes), certified at every stop;
 a run whose open nodes all floor to the incumbent is reported optimal.
 
-Measured (M = 20 targets, K = 3 views, N = 5 UAVs, paper preset, seeds 0..7, 60 s through the
-registry, one thread on a 2-core machine shared with other benchmarks): 6 of 8 proven optimal
-(8-36 s: seeds 0, 2, 3, 4, 6, 7); seed 1 stopped at 56 with bound 57 (57 is optimal: a variant
-run proved it), seed 5 at 55 with bound 56. Before these changes (DSSR to elementary routes, FIFO
-labelling on linked lists, no dive): 1 of 8 proven (pricing ~55 s of the root, exact calls up to
-30 s with 400k labels), bounds 53-60. K = 6 (120 viewpoints, seeds 0..3): bounds 89, 96, 99, 100
-at 60 s (before: 100-119), incumbents 82 (heuristics such as pyvrp find 85-97: the bound is the
-useful output there; the root LP does not converge in 60 s on seeds 1-3). TOP sets 1-3: all 117
-published optima proven, the slowest p3.2.r in ~26 s, median under 0.1 s.
+Measured (2026-12-01, 2-core machine, M = 20 targets, K = 3 views, N = 5 UAVs, paper preset,
+seeds 0..7, 60 s through the registry, one thread):
 
-Subset-row cuts (2026-12-01, same machine, the other core busy): on seed 5, the K = 3 instance
-that 60 s leaves open, 300 s without cuts end at 55 with bound 56 after 173 nodes; with cuts the
-root LP goes from 56.35 to 56.00 with 64 cuts and 55 is proven optimal after 4 nodes in 232 s
-(a second 300 s run, with fewer dives finishing, ended at bound 55 with incumbent 54). Pricing
-pays for them: one exact call at the root with 64 cuts took 19.6 s before the byte-table dual
-sums and the mask-first dominance test, 8.5 s after, 2.0 s with the cut duals zeroed (labels
-269k against 131k). At 60 s on seeds 0..7, cuts proved 5 of 8 against 7 of 8 without them (run
-side by side), and on a 30-viewpoint instance they turned a 2 s proof into 22 s: hence off below
-``CUTS_FROM_S``.
+- The DP suffix bound in the pricing (:mod:`.pricing`) cut root exact pricing on seed 5 from
+  0.47 s to 0.05 s without cuts and from 7.5 s to 2.1 s with 64 cuts (side by side, same values).
+- With it and the PyVRP primal: 6 of 8 proven in each of five batches (this code and variants
+  that order the dives and PyVRP differently), run one instance at a time with the other core
+  busy (proofs in 9-59 s); which seeds stay open varies
+  with timing: seed 5 always (bound 56, optimum 55), and seed 4 or seed 1, stopped with the
+  bound at the optimum (53, 57) and the incumbent one short. With both cores running bp jobs
+  (two runs of the reference suite) 5 and 6 of 8. Before today's changes: 6 or 7 of 8.
+- Seed 5 needs cuts: at 300 s (cuts on) it is proven optimal in 99-183 s (root LP 56.35 -> below
+  56 with 96 cuts, 42-47 purged; 1-3 nodes). Earlier, without purging, 64 cuts left the root LP
+  at 56.006 and the proof took 232 s, or did not come within 300 s.
+- K = 6 (120 viewpoints, seeds 0..7): the root LP now converges in 27-46 s; bounds at 60 s 89,
+  96, 98, 100, 89, 93, 94, 95 (before: 90, 97, 98, 100, 89, 94, 95, 95); incumbents 86-98 (PyVRP's
+  plans); at 300 s (seeds 0..3) 88, 95, 98, 99.
+- TOP sets 1-3: all 117 published optima proven, the slowest (p3.3.o) in 5.5 s, 45 s for all 117
+  in one process (before: p3.2.r in 19-26 s).
+
+Subset-row cuts are off below ``CUTS_FROM_S``: at 60 s, run side by side on seeds 0..7, forced
+cuts proved 5 of 8 both with and without them (after the DP bound; before it 5 against 7), and
+on a 30-viewpoint instance they turned a 2 s proof into 22 s.
 """
 
 from __future__ import annotations
