@@ -217,16 +217,18 @@ class BranchAndPrice:
             return bound
         return self.step * math.floor((bound + 1e-6) / self.step)
 
-    def _offer(self, routes) -> None:
-        """Accept a plan (solver points) as incumbent if the verifier agrees and it is better."""
+    def _offer(self, routes):
+        """Accept a plan (solver points) as incumbent if the verifier agrees and it is better.
+        Returns the verifier's report (None for no plan or more than N routes)."""
         if routes is None or len(routes) > self.N:
-            return
+            return None
         plan = Plan.of([[p - 1 for p in r] for r in routes])
         rep = verify(self.inst, plan)
         if rep.valid and rep.prize > self.incumbent_value + 1e-9:
             self.incumbent_value = rep.prize
             self.incumbent = list(routes)
             self._log()
+        return rep
 
     def _log(self, bound: float | None = None) -> None:
         inc = None if self.incumbent is None else self.incumbent_value
@@ -465,10 +467,9 @@ class BranchAndPrice:
         if not routes:
             return
         pts = [tuple(int(v) + 1 for v in r) for r in routes if len(r)]
-        rep = verify(self.inst, Plan.of([[p - 1 for p in r] for r in pts]))
-        self.stats.primal_prize = float(rep.prize) if rep.valid else None
         before = self.incumbent_value
-        self._offer(pts)
+        rep = self._offer(pts)
+        self.stats.primal_prize = float(rep.prize) if rep is not None and rep.valid else None
         self.stats.primal_improved = self.incumbent_value > before
         self.master.add_routes([r for r in pts if self._energy(r) <= self.budget])
 
@@ -663,8 +664,9 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
     ``initial_routes`` (node ids, e.g. a heuristic plan's routes) are added as starting columns
     and as a first incumbent. ``primal(seconds) -> routes or None`` (node ids) is a heuristic
     run once if the root does not settle the proof, with ``primal_share`` of the time limit (at
-    most ``PRIMAL_CAP_S``); its routes become columns and, if verified and better, the incumbent. ``bidirectional``: exact pricing direction; None picks the faster
-    one on the first exact pricing call. ``seed`` is unused (no randomness; timing-based choices
+    most ``PRIMAL_CAP_S``); its routes become columns and, if verified and better, the
+    incumbent. ``bidirectional``: exact pricing direction; None picks the faster one on the
+    first exact pricing call. ``seed`` is unused (no randomness; timing-based choices
     and the time limit can still change the path taken).
     """
     warm_up()  # JIT compilation (cached on disk after the first run) is not charged to the limit
@@ -683,7 +685,8 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
         "nodes": st.nodes, "rounds": st.rounds, "columns": bp.master.n_routes,
         "exact_pricings": st.exact_pricings, "labels": st.labels, "ng_growths": st.ng_growths,
         "milp_calls": st.milp_calls, "milp_s": round(st.milp_s, 3),
-        "milp_improved": st.milp_improved, "milp_columns": st.milp_columns, "dives": st.dives, "dive_improved": st.dive_improved,
+        "milp_improved": st.milp_improved, "milp_columns": st.milp_columns, "dives": st.dives,
+        "dive_improved": st.dive_improved,
         "cuts": st.cuts, "cuts_purged": st.cuts_purged,
         "root_lp": st.root_lp, "primal_s": st.primal_s, "primal_prize": st.primal_prize,
         "primal_improved": st.primal_improved, "primal_error": st.primal_error,

@@ -258,14 +258,9 @@ class Master:
         self.h.addRows(n, np.full(n, -INF), np.ones(n), len(idx), np.asarray(starts, np.int32),
                        np.asarray(idx, np.int32), np.asarray(vals, dtype=float))
         for S, M in cuts:
-            c = len(self.cuts)
-            bit = np.uint64(1) << np.uint64(c)
+            self._mark_cut(len(self.cuts), S, M)
             self.cuts.append(S)
             self.memories.append(M)
-            for p in S:
-                self.cut_members[p] |= bit
-            for p in M:
-                self.cut_memory[p] |= bit
         self.n_rows += n
         self.row_lo = np.concatenate([self.row_lo, np.full(n, -INF)])
         self.row_hi = np.concatenate([self.row_hi, np.ones(n)])
@@ -295,12 +290,16 @@ class Master:
         self.cut_members[:] = 0
         self.cut_memory[:] = 0
         for c, (S, M) in enumerate(zip(self.cuts, self.memories)):
-            bit = np.uint64(1) << np.uint64(c)
-            for p in S:
-                self.cut_members[p] |= bit
-            for p in M:
-                self.cut_memory[p] |= bit
+            self._mark_cut(c, S, M)
         return int(drop.size)
+
+    def _mark_cut(self, c: int, S, memory) -> None:
+        """Set cut c's bit at the points of its triple and of its memory (the pricing's bitsets)."""
+        bit = np.uint64(1) << np.uint64(c)
+        for p in S:
+            self.cut_members[p] |= bit
+        for p in memory:
+            self.cut_memory[p] |= bit
 
     def cut_duals(self, y: np.ndarray) -> np.ndarray:
         """Duals of the cut rows (>= 0, clipped), in cut order."""
@@ -409,15 +408,20 @@ class Master:
             return np.zeros(0)
         yy = np.zeros(self.n_rows)
         yy[: min(len(y), self.n_rows)] = y[: self.n_rows]
-        a = self.h.getLp().a_matrix_
-        starts = np.asarray(a.start_, dtype=np.int64)[self.n_art : self.n_art + k + 1]
-        index = np.asarray(a.index_, dtype=np.int64)[starts[0] : starts[-1]]
-        value = np.asarray(a.value_)[starts[0] : starts[-1]]
-        terms = value * yy[index]
-        lens = np.diff(starts)
-        at = np.repeat(np.arange(k), lens)
-        used = np.bincount(at, weights=terms, minlength=k)
+        starts, index, value = self._route_matrix()
+        at = np.repeat(np.arange(k), np.diff(starts))
+        used = np.bincount(at, weights=value * yy[index], minlength=k)
         return np.asarray(self.route_prize) - used
+
+    def _route_matrix(self):
+        """The route columns of the LP matrix (CSC, artificials left out): column starts
+        (n_routes + 1, from 0), row indices, values."""
+        a = self.h.getLp().a_matrix_
+        k = self.n_routes
+        starts = np.asarray(a.start_, dtype=np.int64)[self.n_art : self.n_art + k + 1]
+        index = np.asarray(a.index_, dtype=np.int32)[starts[0] : starts[-1]]
+        value = np.asarray(a.value_)[starts[0] : starts[-1]]
+        return starts - starts[0], index, value
 
     def node_visits(self, x: np.ndarray) -> np.ndarray:
         """(V+2,) visit value of each point in an LP solution."""
@@ -443,18 +447,11 @@ class Master:
         h.changeObjectiveSense(highspy.ObjSense.kMaximize)
         h.addRows(self.n_rows, self.row_lo, self.row_hi, 0, np.zeros(self.n_rows, np.int32),
                   np.zeros(0, np.int32), np.zeros(0))
-        lp = self.h.getLp()
-        m = lp.a_matrix_
-        starts = np.asarray(m.start_, dtype=np.int64)
-        index = np.asarray(m.index_, dtype=np.int32)
-        value = np.asarray(m.value_)
-        a0 = starts[self.n_art]
-        st = (starts[self.n_art : self.n_art + k] - a0).astype(np.int32)
-        nnz = int(starts[self.n_art + k] - a0)
+        starts, index, value = self._route_matrix()
         ub = np.ones(k) if allowed is None else np.where(allowed, 1.0, 0.0)
         ub[self.repeated] = 0.0  # never in an integer solution
-        h.addCols(k, np.asarray(self.route_prize), np.zeros(k), ub, nnz, st,
-                  index[a0 : a0 + nnz], value[a0 : a0 + nnz])
+        h.addCols(k, np.asarray(self.route_prize), np.zeros(k), ub, int(starts[-1]),
+                  starts[:-1].astype(np.int32), index, value)
         h.changeColsIntegrality(k, np.arange(k, dtype=np.int32),
                                 np.full(k, highspy.HighsVarType.kInteger))
         h.run()

@@ -168,9 +168,11 @@ def _suffix_dp(cost, profit, allowed, delta, nb):
         for w in range(n):
             c = cost[u, w]
             if u != w and c < np.inf:
-                q = int(c / delta)
-                if q < 1:
-                    q = 1  # not reached: delta <= the cheapest finite arc (checked by the caller)
+                # Below one unit: only arcs the caller leaves out of the unit choice (start ->
+                # end, into the start, out of the end). None leads on to a node; start -> end
+                # rounded up only drops the empty route from g1[0, 0], and the start's one
+                # label has the whole budget left.
+                q = max(int(c / delta), 1)
                 if q <= nb:
                     units[u, w] = q
     for b in range(1, nb + 1):
