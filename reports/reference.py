@@ -22,6 +22,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from benchmarks.reproduce import SUITES  # noqa: E402  (the suites this report renders, run order)
 from reports.results import load_results  # noqa: E402
 
 PAPER = ["adpc-pso", "dpc-pso", "kmeans-pso", "adpc-ga", "adpc-aco"]
@@ -134,8 +135,7 @@ def write_reference(root: str | Path, out: str | Path, *, command: str = "python
     # -- run log
     L += ["## How it was run", ""]
     L += ["| suite | jobs | wall (s) | workers | host cpus | finished |", "|---|---|---|---|---|---|"]
-    for s in ["paper-n", "paper-k", "paper-peers", "exact-small", "paper-gaps", "paper-gaps-long", "emax-sweep",
-              "table1", "top-chao"]:
+    for s in SUITES:
         for w in _walls(root, s):
             if not w["jobs"]:
                 continue  # a resume that found everything stored
