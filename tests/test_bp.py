@@ -477,6 +477,28 @@ def test_milp_column_filter_keeps_every_better_plan(name):
     assert sum(bp.master.route_prize[bp.master.routes.index(r)] for r in sub or []) <= best + 1e-9
 
 
+def test_milp_start_plan_is_a_floor():
+    """The MILP takes a plan as its first solution: with only that plan's routes allowed it
+    returns that plan, under any time limit it returns nothing worse, and a start that is not
+    made of generated routes is ignored (p2.2.k)."""
+    from formulations.bp.branch_price import BranchAndPrice, NodeState
+
+    inst = _top("p2.2.k")
+    bp = BranchAndPrice(inst, time_limit=30)
+    bp.column_generation(NodeState(), np.inf)
+    m = bp.master
+    value = lambda routes: sum(m.route_prize[m.routes.index(r)] for r in routes)  # noqa: E731
+    best = m.milp(20.0)
+    start = sorted(best, key=len)[1:]  # a worse plan: the best without its shortest route
+    assert value(start) < value(best)
+    only = m.milp(5.0, np.zeros(m.n_routes, dtype=bool), start=start)
+    assert sorted(only) == sorted(start)
+    quick = m.milp(0.05, None, start=start)
+    assert quick is not None and value(quick) >= value(start) - 1e-9
+    unknown = [tuple(range(1, inst.n_nodes + 1))]  # not a generated route
+    assert m.milp(5.0, np.zeros(m.n_routes, dtype=bool), start=unknown) in (None, [])
+
+
 # -- limited-memory subset-row cuts ------------------------------------------------------------
 
 def test_lm_coefficient_counts_pairs_and_forgets_outside_memory():

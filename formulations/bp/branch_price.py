@@ -578,7 +578,7 @@ class BranchAndPrice:
                 self.stats.milp_columns = int(allowed.sum())
                 if not allowed.any():
                     return  # no generated route can be part of a better plan
-            self._offer(self.master.milp(limit, allowed))
+            self._offer(self.master.milp(limit, allowed, start=self.incumbent))
             self.stats.milp_s += time.perf_counter() - t
             self.stats.milp_improved += self.incumbent_value > before
 
