@@ -336,6 +336,42 @@ def test_ng_route_columns_count_visits():
     assert list(m.incompatible(NodeState())) == [True, False, False]
 
 
+def test_branching_decisions_exclude_exactly_the_conflicting_routes():
+    """Master.incompatible against its definition, route by route (repeated visits included):
+    a route is out iff it visits a forbidden point, uses a forbidden arc, or leaves the tail of a
+    forced arc (not the start) or enters its head (not the end) by another arc."""
+    from formulations.bp.branch_price import NodeState
+    from formulations.bp.master import Master
+
+    rng = np.random.default_rng(3)
+    V, end = 7, 8
+    m = Master(V, np.ones(V), [], 3)
+    routes = {tuple(int(p) for p in rng.choice(np.arange(1, V + 1), size=rng.integers(1, 6)))
+              for _ in range(300)}  # random, some with repeated points
+    m.add_routes(sorted(routes))
+    assert m.repeated
+    arcs_of = [list(zip([0, *r], [*r, end])) for r in m.routes]
+
+    def out(r, st):
+        arcs = arcs_of[r]
+        return (any(p in st.forbidden_nodes for p in m.routes[r])
+                or any(a in st.forbidden_arcs for a in arcs)
+                or any((a == fa and fa != 0 and b != fb) or (b == fb and fb != end and a != fa)
+                       for fa, fb in st.forced_arcs for a, b in arcs))
+
+    pts = list(range(0, V + 2))
+    for _ in range(40):
+        pick = lambda: (int(rng.choice(pts[:-1])), int(rng.choice(pts[1:])))  # noqa: E731
+        st = NodeState(forbidden_nodes=frozenset(int(p) for p in rng.choice(
+                           np.arange(1, V + 1), size=rng.integers(0, 2))),
+                       forbidden_arcs=frozenset(pick() for _ in range(rng.integers(0, 3))),
+                       forced_arcs=frozenset(pick() for _ in range(rng.integers(0, 3))))
+        got = m.incompatible(st)
+        assert list(got) == [out(r, st) for r in range(m.n_routes)]
+    m.hide_repeated = True
+    assert all(m.incompatible(NodeState())[m.repeated])
+
+
 @pytest.mark.parametrize("value,n", [(57.3, 5), (57.0, 5), (12.999, 3), (4.2, 1)])
 def test_targeted_slack_keeps_the_floor(value, n):
     """The raised exact-pricing threshold: dual value + N * (slack + TOL) stays below the next

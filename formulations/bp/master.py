@@ -105,8 +105,9 @@ class Master:
         self.seen: set[tuple[int, ...]] = set()
         cap = 256
         self._visit = np.zeros((cap, self.V + 2), dtype=np.int16)  # visits of each point
-        self._succ = np.full((cap, self.V + 2), -1, dtype=np.int32)  # successor of each point
-        self._pred = np.full((cap, self.V + 2), -1, dtype=np.int32)
+        # every arc of every route (start 0 and end V+1 included): route, tail, head
+        self._arcs = np.zeros((3, 16 * cap), dtype=np.int32)
+        self.n_arcs = 0
         self.repeated: list[int] = []  # routes (ng-routes) that visit some point twice
         self.dead: set[int] = set()  # repeated routes that are no ng-routes of the grown ng sets
         self.hide_repeated = False  # True while a primal heuristic wants elementary routes only
@@ -137,11 +138,14 @@ class Master:
         need = k0 + len(new)
         if need > self._visit.shape[0]:
             cap = max(need, 2 * self._visit.shape[0])
-            for name, fill in (("_visit", 0), ("_succ", -1), ("_pred", -1)):
-                old = getattr(self, name)
-                arr = np.full((cap, self.V + 2), fill, dtype=old.dtype)
-                arr[: old.shape[0]] = old
-                setattr(self, name, arr)
+            visit = np.zeros((cap, self.V + 2), dtype=self._visit.dtype)
+            visit[: self._visit.shape[0]] = self._visit
+            self._visit = visit
+        arcs_needed = self.n_arcs + sum(len(r) + 1 for r in new)
+        if arcs_needed > self._arcs.shape[1]:
+            arcs = np.zeros((3, max(arcs_needed, 2 * self._arcs.shape[1])), dtype=np.int32)
+            arcs[:, : self.n_arcs] = self._arcs[:, : self.n_arcs]
+            self._arcs = arcs
         starts, idx, vals, costs = [], [], [], []
         nnz = 0
         end = self.V + 1
@@ -155,9 +159,11 @@ class Master:
             if len(set(r)) < len(r):
                 self.repeated.append(k)
             full = [0, *r, end]
-            for a, b in zip(full, full[1:]):
-                self._succ[k, a] = b
-                self._pred[k, b] = a
+            j = self.n_arcs
+            self._arcs[0, j : j + len(r) + 1] = k
+            self._arcs[1, j : j + len(r) + 1] = full[:-1]
+            self._arcs[2, j : j + len(r) + 1] = full[1:]
+            self.n_arcs = j + len(r) + 1
             coef: dict[int, float] = {0: 1.0}
             for p in r:
                 coef[p] = coef.get(p, 0.0) + 1.0
@@ -307,33 +313,26 @@ class Master:
 
     # -- branching state -------------------------------------------------------------------
     def incompatible(self, state) -> np.ndarray:
-        """(n_routes,) bool: routes that a branch-and-bound node's decisions exclude."""
+        """(n_routes,) bool: routes that a branch-and-bound node's decisions exclude (checked
+        on the arc list of all routes at once, so repeated visits count like any other)."""
         k = self.n_routes
-        visit, succ, pred = self._visit[:k], self._succ[:k], self._pred[:k]
         bad = np.zeros(k, dtype=bool)
         for p in state.forbidden_nodes:
-            bad |= visit[:, p] > 0
-        for a, b in state.forbidden_arcs:
-            bad |= succ[:, a] == b
-        end = self.V + 1
-        for a, b in state.forced_arcs:
-            if a != 0:
-                bad |= (visit[:, a] > 0) & (succ[:, a] != b)
-            if b != end:
-                bad |= (visit[:, b] > 0) & (pred[:, b] != a)
-        # succ/pred keep only the last visit of a repeated point: check those routes arc by arc
-        for r in self.repeated:
-            if r in self.dead or self.hide_repeated:
-                bad[r] = True
-                continue
-            full = [0, *self.routes[r], end]
-            arcs = list(zip(full, full[1:]))
-            out = any(a == p for p in state.forbidden_nodes for a in self.routes[r])
-            out = out or any(arc in state.forbidden_arcs for arc in arcs)
-            for fa, fb in state.forced_arcs:
-                out = out or any((a == fa and fa != 0 and b != fb) or (b == fb and fb != end and a != fa)
-                                 for a, b in arcs)
-            bad[r] = out
+            bad |= self._visit[:k, p] > 0
+        if state.forbidden_arcs or state.forced_arcs:
+            route, tail, head = self._arcs[:, : self.n_arcs]
+            end = self.V + 1
+            for a, b in state.forbidden_arcs:
+                bad[route[(tail == a) & (head == b)]] = True
+            for a, b in state.forced_arcs:  # nothing else may leave a or enter b
+                if a != 0:
+                    bad[route[(tail == a) & (head != b)]] = True
+                if b != end:
+                    bad[route[(head == b) & (tail != a)]] = True
+        if self.hide_repeated:
+            bad[self.repeated] = True
+        if self.dead:
+            bad[list(self.dead)] = True
         return bad
 
     def kill_non_ng(self, ng: np.ndarray) -> int:
