@@ -513,6 +513,29 @@ def test_milp_column_filter_keeps_every_better_plan(name):
     assert sum(bp.master.route_prize[bp.master.routes.index(r)] for r in sub or []) <= best + 1e-9
 
 
+def test_strong_branching_proves_the_same_optimum():
+    """Strong branching (children estimated on the current columns) changes which candidate is
+    branched on, never the result: p3.3.o is proven at its published optimum either way, only
+    the strong run pays for estimates, and the master's bounds are the node's again after them."""
+    from formulations.bp.branch_price import BranchAndPrice, NodeState
+
+    inst = _top("p3.3.o")
+    results = {st: solve_bp(inst, time_limit=30, strong=st) for st in (1, 5)}
+    for st, r in results.items():
+        assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p3.3.o"])
+        assert verify(inst, r.plan).valid
+        assert (r.info["strong_lps"] > 0) == (st > 1)
+    bp = BranchAndPrice(inst, time_limit=30)
+    _, x, _, _ = bp.column_generation(NodeState(), np.inf)
+    cands = bp._branch_candidates(NodeState(), x)
+    assert len(cands) > 1
+    before = bp.master.col_ub.copy()
+    lp = float(np.dot(bp.master.route_prize, x[: bp.master.n_routes]))
+    pick = bp._branch(NodeState(), x, lp)
+    assert pick in cands[: bp.strong]
+    assert np.array_equal(bp.master.col_ub, before)
+
+
 def test_milp_start_plan_is_a_floor():
     """The MILP takes a plan as its first solution: with only that plan's routes allowed it
     returns that plan, under any time limit it returns nothing worse, and a start that is not

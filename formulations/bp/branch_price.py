@@ -33,7 +33,12 @@ labelling pricing (:mod:`.pricing`):
 Branching, in order: on a fractional node visit (forbid the node / force it visited: a forced node
 row becomes ``= 1``); then, when all visits are integral, on a fractional arc flow (forbid the arc
 / force it: the tail may only go to the head and the head may only be reached from the tail).
-Both keep the pricing a plain labelling on a modified graph. With integral visits and arc flows an
+Both keep the pricing a plain labelling on a modified graph. Strong branching picks among the
+``strong`` (5) most fractional candidates the one whose two children, re-solved on the current
+columns without pricing (an estimate), drop most below the node's LP value (product of the
+drops). On seed 5 below (cuts off, 300 s, side by side) it proved the optimum in 134 s with 95
+nodes (32 s of them in the estimates, before the exclusions were vectorised), where the most
+fractional choice alone left 7 nodes open after 316. With integral visits and arc flows an
 LP solution of elementary routes is integral (each positive route follows the unique flow-1 arcs);
 a node where that still fails (repeated routes) stays unresolved and the run is not reported
 proven. Nodes are explored best floored bound first, deepest first among equals (depth first
@@ -101,6 +106,7 @@ TOL = 1e-6
 CUTS_FROM_S = 120.0  # time limits from which subset-row cuts are on by default
 PRIMAL_SHARE = 0.1  # of the time limit for the caller's heuristic (``primal``) ...
 PRIMAL_CAP_S = 10.0  # ... but at most this many seconds
+STRONG = 5  # branching candidates compared by their children's restricted LPs
 
 
 @dataclass(frozen=True)
@@ -128,6 +134,9 @@ class _Stats:
     nodes: int = 0
     milp_calls: int = 0
     milp_s: float = 0.0
+    strong_lps: int = 0
+    strong_s: float = 0.0
+    open_nodes: int = 0  # nodes left unsolved at the limit (0 when proven)
     milp_improved: int = 0  # MILP calls that raised the incumbent
     milp_columns: int | None = None  # routes the last MILP could use (reduced-cost filter)
     dives: int = 0
@@ -152,8 +161,9 @@ class BranchAndPrice:
                  initial_routes=None, bidirectional: bool | None = None, ng_columns: bool = True,
                  ng_cap: int = 12, grow_share: float = 0.3, cut_rounds: int | None = None,
                  cuts_per_round: int = 16, cut_gap: float = 0.5, cut_share: float = 0.35,
-                 primal=None, primal_share: float = PRIMAL_SHARE):
+                 primal=None, primal_share: float = PRIMAL_SHARE, strong: int = STRONG):
         self.primal = primal
+        self.strong = strong
         self.root_cert = None  # (duals, their dual term, best reduced prize bound, bound)
         if cut_rounds is None:  # auto: cuts only pay back their slower pricing on long runs
             long_run = time_limit is None or float(time_limit) >= CUTS_FROM_S
@@ -533,22 +543,48 @@ class BranchAndPrice:
             state = state.child(forced_nodes=m.routes[r], forced_arcs=list(zip(full, full[1:])))
 
     # -- branch and bound ------------------------------------------------------------------
-    def _branch(self, state: NodeState, x: np.ndarray):
+    def _branch_candidates(self, state: NodeState, x: np.ndarray):
+        """Child pairs to branch on, most fractional first: visits of a point (forced /
+        forbidden) while some are fractional, else arc flows (forced / forbidden)."""
         m = self.master
         visits = m.node_visits(x)[1 : self.V + 1]
         frac = np.abs(visits - np.round(visits))
-        if frac.max() > TOL:
-            p = int(np.argmax(-np.abs(visits - 0.5) + (frac <= TOL) * -10.0)) + 1
-            return [state.child(forced_nodes=[p]), state.child(forbidden_nodes=[p])]
-        flows = m.arc_flows(x)
-        best, arc = TOL, None
-        for a, f in flows.items():
-            d = abs(f - round(f))
-            if d > best and min(f, 1 - f) > TOL:
-                best, arc = d, a
-        if arc is None:
+        pts = np.flatnonzero(frac > TOL)
+        if pts.size:
+            pts = pts[np.argsort(np.abs(visits[pts] - 0.5), kind="stable")] + 1
+            return [[state.child(forced_nodes=[int(p)]), state.child(forbidden_nodes=[int(p)])]
+                    for p in pts]
+        arcs = [(abs(f - 0.5), a) for a, f in m.arc_flows(x).items() if min(f, 1 - f) > TOL]
+        arcs.sort()
+        return [[state.child(forced_arcs=[a]), state.child(forbidden_arcs=[a])] for _, a in arcs]
+
+    def _branch(self, state: NodeState, x: np.ndarray, lp_value: float):
+        """Children of a node, or None if its LP solution is integral in visits and arcs.
+        Strong branching on the restricted master: of the ``strong`` most fractional
+        candidates, the one whose children's re-solved LPs (current columns, no pricing: a
+        cheap estimate) drop most below the node's value (product of the two drops, each at
+        least 1e-3 so that a free child does not hide the other)."""
+        cands = self._branch_candidates(state, x)
+        if not cands:
             return None
-        return [state.child(forced_arcs=[arc]), state.child(forbidden_arcs=[arc])]
+        if self.strong <= 1 or len(cands) == 1:
+            return cands[0]
+        m = self.master
+        t = time.perf_counter()
+        best, pick = -1.0, cands[0]
+        for pair in cands[: self.strong]:
+            drops = []
+            for ch in pair:
+                m.apply(ch)
+                value = m.solve()[0]
+                drops.append(max(lp_value - value, 1e-3))
+            score = drops[0] * drops[1]
+            if score > best:
+                best, pick = score, pair
+        self.stats.strong_lps += 2 * min(len(cands), self.strong)
+        m.apply(state)
+        self.stats.strong_s += time.perf_counter() - t
+        return pick
 
     def _node_key(self, bound: float, depth: int, counter: int, state: NodeState):
         """Heap entry: best floored bound first, then deepest. Pruning only looks at floored
@@ -628,7 +664,8 @@ class BranchAndPrice:
             if xa.max() <= TOL and np.all(np.abs(x - np.round(x)) <= TOL):
                 self._offer([self.master.routes[r] for r in np.flatnonzero(x > 0.5)])
                 continue
-            children = self._branch(state, x)
+            lp_value = float(np.dot(self.master.route_prize, x[: self.master.n_routes]))
+            children = self._branch(state, x, lp_value)
             if children is None:
                 unresolved.append(bound)
                 continue
@@ -643,6 +680,7 @@ class BranchAndPrice:
         if not proven and self.master.n_routes:
             self._run_milp(max(0.0, self.hard_deadline - time.perf_counter() - 0.1))
         open_bounds = [-item[2] for item in heap] + unresolved
+        self.stats.open_nodes = sum(not self._prunable(b) for b in open_bounds)
         inc = self.incumbent_value if self.incumbent is not None else -math.inf
         if open_bounds:
             open_bound = max(self._floor(b) for b in open_bounds)
@@ -658,7 +696,8 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
              initial_routes=None, ng_size: int = 8, bidirectional: bool | None = None,
              ng_columns: bool = True, ng_cap: int = 12, grow_share: float = 0.3,
              cut_rounds: int | None = None, cuts_per_round: int = 16, cut_gap: float = 0.5,
-             cut_share: float = 0.35, primal=None, primal_share: float = PRIMAL_SHARE) -> Result:
+             cut_share: float = 0.35, primal=None, primal_share: float = PRIMAL_SHARE,
+             strong: int = STRONG) -> Result:
     """Branch-and-price: proven optimum, or the best plan and a certified bound at the limit.
 
     ``initial_routes`` (node ids, e.g. a heuristic plan's routes) are added as starting columns
@@ -678,7 +717,8 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
                         initial_routes=initial_routes, bidirectional=bidirectional,
                         ng_columns=ng_columns, ng_cap=ng_cap, grow_share=grow_share,
                         cut_rounds=cut_rounds, cuts_per_round=cuts_per_round, cut_gap=cut_gap,
-                        cut_share=cut_share, primal=primal, primal_share=primal_share)
+                        cut_share=cut_share, primal=primal, primal_share=primal_share,
+                        strong=strong)
     proven, bound = bp.run()
     st = bp.stats
     info = {
@@ -686,7 +726,9 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
         "exact_pricings": st.exact_pricings, "labels": st.labels, "ng_growths": st.ng_growths,
         "milp_calls": st.milp_calls, "milp_s": round(st.milp_s, 3),
         "milp_improved": st.milp_improved, "milp_columns": st.milp_columns, "dives": st.dives,
-        "dive_improved": st.dive_improved,
+        "dive_improved": st.dive_improved, "strong_lps": st.strong_lps,
+        "strong_s": round(st.strong_s, 3),
+        "open_nodes": st.open_nodes,
         "cuts": st.cuts, "cuts_purged": st.cuts_purged,
         "root_lp": st.root_lp, "primal_s": st.primal_s, "primal_prize": st.primal_prize,
         "primal_improved": st.primal_improved, "primal_error": st.primal_error,
