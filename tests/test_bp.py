@@ -419,6 +419,10 @@ def test_registered_bp_starts_from_greedy():
     assert g.status == Status.FEASIBLE and r.plan is not None and rep.valid
     assert r.objective >= g.objective and r.bound >= r.objective
     assert r.info["warm_start_prize"] == g.objective
+    # stopped with a gap, some node is left open; a proven run leaves none
+    assert r.status != Status.OPTIMAL and r.bound > r.objective and r.info["open_nodes"] >= 1
+    proven = solve_bp(_top("p3.3.o"), time_limit=30)
+    assert proven.status == Status.OPTIMAL and proven.info["open_nodes"] == 0
 
 
 def _top(name):
