@@ -360,14 +360,19 @@ def test_branching_decisions_exclude_exactly_the_conflicting_routes():
                        for fa, fb in st.forced_arcs for a, b in arcs))
 
     pts = list(range(0, V + 2))
-    for _ in range(40):
+    shared = 0  # states where two forced arcs leave the same point (or enter the same one)
+    for _ in range(200):
         pick = lambda: (int(rng.choice(pts[:-1])), int(rng.choice(pts[1:])))  # noqa: E731
         st = NodeState(forbidden_nodes=frozenset(int(p) for p in rng.choice(
                            np.arange(1, V + 1), size=rng.integers(0, 2))),
                        forbidden_arcs=frozenset(pick() for _ in range(rng.integers(0, 3))),
-                       forced_arcs=frozenset(pick() for _ in range(rng.integers(0, 3))))
+                       forced_arcs=frozenset(pick() for _ in range(rng.integers(0, 5))))
+        tails = [a for a, _ in st.forced_arcs if a != 0]
+        heads = [b for _, b in st.forced_arcs if b != end]
+        shared += len(set(tails)) < len(tails) or len(set(heads)) < len(heads)
         got = m.incompatible(st)
         assert list(got) == [out(r, st) for r in range(m.n_routes)]
+    assert shared > 0
     m.hide_repeated = True
     assert all(m.incompatible(NodeState())[m.repeated])
 

@@ -324,11 +324,17 @@ class Master:
             end = self.V + 1
             for a, b in state.forbidden_arcs:
                 bad[route[(tail == a) & (head == b)]] = True
-            for a, b in state.forced_arcs:  # nothing else may leave a or enter b
+            # forced (a, b): nothing else may leave a or enter b. One pass over the arcs for
+            # all forced arcs: out_to[a] = b (-1 free, -2 two forced arcs leave a: none may)
+            out_to = np.full(self.V + 2, -1, dtype=np.int64)
+            in_from = np.full(self.V + 2, -1, dtype=np.int64)
+            for a, b in state.forced_arcs:
                 if a != 0:
-                    bad[route[(tail == a) & (head != b)]] = True
+                    out_to[a] = b if out_to[a] in (-1, b) else -2
                 if b != end:
-                    bad[route[(head == b) & (tail != a)]] = True
+                    in_from[b] = a if in_from[b] in (-1, a) else -2
+            o, i = out_to[tail], in_from[head]
+            bad[route[((o != -1) & (o != head)) | ((i != -1) & (i != tail))]] = True
         if self.hide_repeated:
             bad[self.repeated] = True
         if self.dead:
