@@ -549,20 +549,22 @@ class BranchAndPrice:
             state = state.child(forced_nodes=m.routes[r], forced_arcs=list(zip(full, full[1:])))
 
     # -- branch and bound ------------------------------------------------------------------
-    def _branch_candidates(self, state: NodeState, x: np.ndarray):
-        """Child pairs to branch on, most fractional first: visits of a point (forced /
-        forbidden) while some are fractional, else arc flows (forced / forbidden)."""
+    def _branch_candidates(self, state: NodeState, x: np.ndarray, limit: int | None = None):
+        """Child pairs to branch on, most fractional first (the first ``limit``): visits of a
+        point (forced / forbidden) while some are fractional, else arc flows (forced /
+        forbidden)."""
         m = self.master
         visits = m.node_visits(x)[1 : self.V + 1]
         frac = np.abs(visits - np.round(visits))
         pts = np.flatnonzero(frac > TOL)
         if pts.size:
-            pts = pts[np.argsort(np.abs(visits[pts] - 0.5), kind="stable")] + 1
+            pts = pts[np.argsort(np.abs(visits[pts] - 0.5), kind="stable")][:limit] + 1
             return [[state.child(forced_nodes=[int(p)]), state.child(forbidden_nodes=[int(p)])]
                     for p in pts]
         arcs = [(abs(f - 0.5), a) for a, f in m.arc_flows(x).items() if min(f, 1 - f) > TOL]
         arcs.sort()
-        return [[state.child(forced_arcs=[a]), state.child(forbidden_arcs=[a])] for _, a in arcs]
+        return [[state.child(forced_arcs=[a]), state.child(forbidden_arcs=[a])]
+                for _, a in arcs[:limit]]
 
     def _branch(self, state: NodeState, x: np.ndarray, lp_value: float):
         """Children of a node, or None if its LP solution is integral in visits and arcs.
@@ -570,7 +572,7 @@ class BranchAndPrice:
         candidates, the one whose children's re-solved LPs (current columns, no pricing: a
         cheap estimate) drop most below the node's value (product of the two drops, each at
         least 1e-3 so that a free child does not hide the other)."""
-        cands = self._branch_candidates(state, x)
+        cands = self._branch_candidates(state, x, max(self.strong, 1))
         if not cands:
             return None
         if self.strong <= 1 or len(cands) == 1:
@@ -578,7 +580,7 @@ class BranchAndPrice:
         m = self.master
         t = time.perf_counter()
         best, pick = -1.0, cands[0]
-        for pair in cands[: self.strong]:
+        for pair in cands:
             drops = []
             for ch in pair:
                 m.apply(ch)
@@ -587,7 +589,7 @@ class BranchAndPrice:
             score = drops[0] * drops[1]
             if score > best:
                 best, pick = score, pair
-        self.stats.strong_lps += 2 * min(len(cands), self.strong)
+        self.stats.strong_lps += 2 * len(cands)
         m.apply(state)
         self.stats.strong_s += time.perf_counter() - t
         return pick
