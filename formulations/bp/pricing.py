@@ -245,11 +245,13 @@ def _byte_sums(duals: np.ndarray) -> np.ndarray:
 
 @njit(cache=True)
 def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
-           lastord, cend, threshold, deadline, half, cmem, mmem, sig, g1, s1, g2, delta, nb):
+           lastord, cend, threshold, deadline, half, cmem, mmem, sig, g1, s1, g2, delta, nb,
+           fixed):
     """Labelling from node 0 to node n-1.
 
     Returns (count, node, pred, energy, prize, mask, alive, hit_cap, threshold). Labels whose
-    prize plus the completion bound cannot exceed ``threshold`` are not stored; only labels with
+    prize plus the completion bound cannot exceed ``threshold`` are not stored (in exact mode the
+    threshold rises to the best complete path found, unless ``fixed``); only labels with
     energy <= ``half`` are extended (``half`` = budget for a one-way search). Labels are kept in
     creation order (global arrays, for the paths) and, for the dominance tests, in contiguous
     per-node buckets (energy, prize, mask, label id) so that the scans stay in cache.
@@ -302,9 +304,10 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
         v = node[qi]
         if en[qi] > half:
             continue
-        # the threshold may have risen since this label was stored
-        if pr[qi] + _dp_bound(g1, s1, g2, v, node[pred[qi]] if qi > 0 else -1, budget - en[qi],
-                              delta, nb) <= threshold:
+        # the threshold may have risen since this label was stored. Whatever the label's
+        # predecessor, g1 (not g2): the label may stand in for a label it dominates whose best
+        # suffix starts with this label's predecessor
+        if pr[qi] + _dp_bound(g1, s1, g2, v, -1, budget - en[qi], delta, nb) <= threshold:
             continue
         if pr[qi] + _completion(mask[qi], v, budget - en[qi], threshold - pr[qi], order, profit,
                                 cin, reach, lastord, cend) <= threshold:
@@ -419,7 +422,7 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             pred[count] = qi
             en[count] = e2
             pr[count] = p2
-            if not heuristic and p2 > threshold and e2 + cost[w, end] <= budget:
+            if not (heuristic or fixed) and p2 > threshold and e2 + cost[w, end] <= budget:
                 threshold = p2  # exact mode looks for the best path: prune against the best found
             alive[count] = True
             srb[count] = s2
@@ -594,6 +597,18 @@ def suffix_tables(cost, profit, allowed, budget, units: int = DP_UNITS):
     points (start -> end aside) if that is smaller, so that every arc costs at least one unit;
     when that would take more than ``DP_MAX_UNITS`` units the tables are off (``nb`` = 0)."""
     n = cost.shape[0]
+    delta, nb = _dp_unit(cost, budget, units)
+    if nb == 0:
+        z = np.full((n, 1), np.inf)
+        return z, np.full((n, 1), -1, np.int32), z, 1.0, 0
+    g1, s1, g2 = _suffix_dp(cost, np.ascontiguousarray(profit, dtype=np.float64), allowed,
+                            delta, nb)
+    return g1, s1, g2, delta, nb
+
+
+def _dp_unit(cost, budget, units):
+    """(delta, nb) of the suffix tables (see :func:`suffix_tables`); nb = 0: tables off."""
+    n = cost.shape[0]
     off = np.isfinite(cost) & ~np.eye(n, dtype=bool)
     off[0, n - 1] = off[n - 1, 0] = False
     off[:, 0] = False
@@ -603,12 +618,124 @@ def suffix_tables(cost, profit, allowed, budget, units: int = DP_UNITS):
     if cheapest < delta:
         delta = cheapest
     if not (budget > 0 and delta > 0 and budget / delta <= DP_MAX_UNITS):
-        z = np.full((n, 1), np.inf)
-        return z, np.full((n, 1), -1, np.int32), z, 1.0, 0
-    nb = int(budget / delta) + 1
-    g1, s1, g2 = _suffix_dp(cost, np.ascontiguousarray(profit, dtype=np.float64), allowed,
-                            delta, nb)
-    return g1, s1, g2, delta, nb
+        return 1.0, 0
+    return delta, int(budget / delta) + 1
+
+
+@njit(cache=True)
+def _through_arcs(cost, prefix, suffix, profit, delta, nb):
+    """``best[i, j]``: max over unit splits of prefix[i, b1] + suffix[j, b2] with
+    b1 + units(i, j) + b2 <= nb, plus the prizes of i and j (-inf where nothing fits)."""
+    n = cost.shape[0]
+    best = np.full((n, n), -np.inf)
+    for i in range(n - 1):
+        for j in range(1, n):
+            c = cost[i, j]
+            if i == j or not c < np.inf:
+                continue
+            q = int(c / delta)
+            if q > nb:
+                continue
+            r = nb - q
+            v = -np.inf
+            for b1 in range(r + 1):
+                a = prefix[i, b1]
+                if a == -np.inf:
+                    continue
+                s = a + suffix[j, r - b1]
+                if s > v:
+                    v = s
+            if v > -np.inf:
+                best[i, j] = v + profit[i] + profit[j]
+    return best
+
+
+def arc_bounds(cost, profit, allowed, budget, units: int = DP_UNITS):
+    """(n, n) upper bound on the prize (sum of ``profit``) of any path start -> ... -> i -> j
+    -> ... -> end of energy <= ``budget`` that uses arc (i, j); +inf everywhere when the suffix
+    tables are off, -inf for arcs no such path uses.
+
+    Both halves come from :func:`_suffix_dp`: the suffix j -> ... -> end on the graph, the
+    prefix start -> ... -> i as a suffix of the reversed graph (start and end swapped). They are
+    2-cycle-free walks with arcs rounded down to whole units, and the arc (i, j) itself is
+    rounded down too, so every elementary path through (i, j) is among the combinations (the
+    join may turn back at i or j: that only admits more walks). Used for reduced-cost arc
+    elimination."""
+    n = cost.shape[0]
+    end = n - 1
+    profit = np.ascontiguousarray(profit, dtype=np.float64)
+    delta, nb = _dp_unit(cost, budget, units)
+    if nb == 0:
+        return np.full((n, n), np.inf)
+    g1, _, _ = _suffix_dp(cost, profit, allowed, delta, nb)
+    perm, cost_b, profit_b, allowed_b = _reversed(cost, profit, allowed)
+    h1, _, _ = _suffix_dp(cost_b, profit_b, allowed_b, delta, nb)
+    prefix = h1[perm]  # prefix[i, b]: start -> ... -> i (i's own prize not counted)
+    prefix[0] = 0.0  # the start: an empty prefix
+    suffix = g1.copy()
+    suffix[end] = 0.0
+    return _through_arcs(np.ascontiguousarray(cost), np.ascontiguousarray(prefix),
+                         np.ascontiguousarray(suffix), profit, delta, nb)
+
+
+def _reversed(cost, profit, allowed):
+    """The reversed graph (start and end swapped, arcs turned): permutation, cost, profit,
+    allowed. Points 1..n-2 keep their numbers."""
+    end = cost.shape[0] - 1
+    perm = np.concatenate([[end], np.arange(1, end), [0]])
+    return (perm, np.ascontiguousarray(cost.T[np.ix_(perm, perm)]),
+            np.ascontiguousarray(profit[perm]), allowed[perm])
+
+
+def _label_table(cost, profit, budget, ng, allowed, threshold, max_labels, deadline, delta, nb):
+    """``t[v, b]``: the best prize of a label at v of energy <= b units, over the labels of a
+    one-way exact ng-labelling with the fixed ``threshold`` (None if it hit a cap)."""
+    n = cost.shape[0]
+    ret = cheapest_return(cost)
+    order, cin, reach, lastord, cend = _prepare(cost, ret, profit, allowed)
+    count, node, _, en, pr, _, _, hit, _ = _label(
+        cost, ret, profit, budget, ng, allowed, False, max_labels, order, cin, reach, lastord,
+        cend, float(threshold), float(deadline), float(budget), np.zeros(n, np.uint64),
+        np.zeros(n, np.uint64), np.zeros((8, 256)), *suffix_tables(cost, profit, allowed, budget),
+        True,
+    )
+    if hit:
+        return None
+    table = np.full((n, nb + 1), -np.inf)
+    units = np.minimum((en / delta + 1e-9).astype(np.int64), nb)
+    np.maximum.at(table, (node, units), pr)
+    return np.maximum.accumulate(table, axis=1)
+
+
+def label_arc_bounds(cost, profit, allowed, budget, ng, threshold, *, max_labels=2_000_000,
+                     deadline=np.inf, units: int = DP_UNITS):
+    """Like :func:`arc_bounds`, from exact ng-labelling instead of the 2-cycle-free DP: the
+    prefix table from one-way labels start -> i, the suffix table from labels of the reversed
+    graph, over the whole budget, with completion-bound pruning against the fixed
+    ``threshold``. Exact for what it is used for: every elementary path through (i, j) with a
+    prize above ``threshold`` is bounded by ``best[i, j]`` (each prefix of such a path is a
+    label or dominated by one, which has no less prize and no more energy); arcs of no such path
+    get a value <= ``threshold``. None when a search hit ``max_labels`` or the ``deadline``."""
+    n = cost.shape[0]
+    end = n - 1
+    profit = np.ascontiguousarray(profit, dtype=np.float64)
+    delta, nb = _dp_unit(cost, budget, units)
+    if nb == 0:
+        return None
+    fwd = _label_table(np.ascontiguousarray(cost), profit, budget, ng, allowed, threshold,
+                       max_labels, deadline, delta, nb)
+    if fwd is None:
+        return None
+    perm, cost_b, profit_b, allowed_b = _reversed(cost, profit, allowed)
+    bwd = _label_table(cost_b, profit_b, budget, ng, allowed_b, threshold, max_labels,
+                       deadline, delta, nb)
+    if bwd is None:
+        return None
+    prefix, suffix = fwd, bwd[perm]  # labels count their own point's prize
+    prefix[0] = 0.0
+    suffix[end] = 0.0
+    return _through_arcs(np.ascontiguousarray(cost), np.ascontiguousarray(prefix),
+                         np.ascontiguousarray(suffix), np.zeros(n), delta, nb)
 
 
 def _chain(node, pred, j):
@@ -664,7 +791,7 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     count, node, pred, en, pr, fmask, falive, hit, thr = _label(
         cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
         lastord, cend, float(min_gain), float(deadline), half, cmem, mmem, sig,
-        *suffix_tables(cost, profit, allowed, budget),
+        *suffix_tables(cost, profit, allowed, budget), False,
     )
     total = int(count)
     found = []  # (value, path)
@@ -674,16 +801,13 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
         found.append((float(pr[li]), _chain(node, pred, int(li))))
     best = float(pr[ok].max()) if ok.any() else 0.0
     if bidirectional and not hit:
-        perm = np.concatenate([[end], np.arange(1, end), [0]])
-        cost_b = np.ascontiguousarray(cost.T[np.ix_(perm, perm)])
+        perm, cost_b, profit_b, allowed_b = _reversed(cost, profit, allowed)
         ret_b = cheapest_return(cost_b)
-        allowed_b = allowed[perm]
-        profit_b = np.ascontiguousarray(profit[perm])
         order_b, cin_b, reach_b, lastord_b, cend_b = _prepare(cost_b, ret_b, profit_b, allowed_b)
         bcount, bnode, bpred, ben, bpr, bmask, balive, bhit, thr = _label(
             cost_b, ret_b, profit_b, budget, ng, allowed_b, heuristic, max_labels, order_b, cin_b,
             reach_b, lastord_b, cend_b, float(thr), float(deadline), half, cmem[perm], mmem[perm], sig,
-            *suffix_tables(cost_b, profit_b, allowed_b, budget),
+            *suffix_tables(cost_b, profit_b, allowed_b, budget), False,
         )
         total += int(bcount)
         hit = hit or bhit
