@@ -111,6 +111,8 @@ class Master:
         self.repeated: list[int] = []  # routes (ng-routes) that visit some point twice
         self.dead: set[int] = set()  # repeated routes that are no ng-routes of the grown ng sets
         self.hide_repeated = False  # True while a primal heuristic wants elementary routes only
+        # arcs no plan better than the incumbent uses (reduced-cost arc elimination)
+        self.eliminated = np.zeros((n_nodes + 2, n_nodes + 2), dtype=bool)
         self.col_ub = np.zeros(0)
         self.cur_lo = self.row_lo.copy()
         self.cuts: list[tuple[int, ...]] = []  # subset-row triples (solver points)
@@ -313,14 +315,17 @@ class Master:
 
     # -- branching state -------------------------------------------------------------------
     def incompatible(self, state) -> np.ndarray:
-        """(n_routes,) bool: routes that a branch-and-bound node's decisions exclude (checked
-        on the arc list of all routes at once, so repeated visits count like any other)."""
+        """(n_routes,) bool: routes that a branch-and-bound node's decisions or the arc
+        elimination exclude (checked on the arc list of all routes at once, so repeated visits
+        count like any other)."""
         k = self.n_routes
         bad = np.zeros(k, dtype=bool)
         for p in state.forbidden_nodes:
             bad |= self._visit[:k, p] > 0
+        route, tail, head = self._arcs[:, : self.n_arcs]
+        if self.eliminated.any():
+            bad[route[self.eliminated[tail, head]]] = True
         if state.forbidden_arcs or state.forced_arcs:
-            route, tail, head = self._arcs[:, : self.n_arcs]
             end = self.V + 1
             for a, b in state.forbidden_arcs:
                 bad[route[(tail == a) & (head == b)]] = True
