@@ -794,7 +794,7 @@ def test_cuts_are_on_by_default_for_long_runs_only():
     from formulations.bp.branch_price import CUTS_FROM_S, BranchAndPrice
 
     inst = random_tiny(0, groups=False)
-    assert BranchAndPrice(inst, time_limit=60).cut_rounds == 0
+    assert BranchAndPrice(inst, time_limit=CUTS_FROM_S - 1).cut_rounds == 0
     assert BranchAndPrice(inst, time_limit=CUTS_FROM_S).cut_rounds > 0
     assert BranchAndPrice(inst, time_limit=None).cut_rounds > 0
     assert BranchAndPrice(inst, time_limit=None, cut_rounds=0).cut_rounds == 0

@@ -23,7 +23,7 @@ labelling pricing (:mod:`.pricing`):
    Larger ng sets make pricing slower, so sets only grow in the first ``grow_share`` (30 %) of the
    time limit; after that, branching decides.
 5. limited-memory subset-row cuts (:mod:`.master`), on by default for time limits of at least
-   ``CUTS_FROM_S`` (120 s; ``cut_rounds`` = 0 turns them off, a number turns them on): at the
+   ``CUTS_FROM_S`` (60 s; ``cut_rounds`` = 0 turns them off, a number turns them on): at the
    root, once the floored bound is settled and the ng sets stop growing, up to ``cut_rounds``
    (6) rounds of ``cuts_per_round`` (16) most violated triples, each followed by column
    generation with the cut duals in the pricing. At most 64 cuts at a time: when a round would
@@ -98,9 +98,12 @@ seeds 0..7, 60 s through the registry, one thread):
   27 s, seeds 1 and 5 open); seed 5 at 300 s proven in 178 s with cuts (default) and in 134 s
   with cuts off; K = 6 bounds and incumbents as above.
 
-Subset-row cuts are off below ``CUTS_FROM_S``: at 60 s, run side by side on seeds 0..7, forced
-cuts proved 5 of 8 both with and without them (after the DP bound; before it 5 against 7), and
-on a 30-viewpoint instance they turned a 2 s proof into 22 s.
+Subset-row cuts are off below ``CUTS_FROM_S`` (60 s): on a 30-viewpoint instance they once
+turned a 2 s proof into 22 s. Before arc elimination the threshold was 120 s (at 60 s, side by
+side on seeds 0..7, forced cuts proved 5 of 8 both with and without them). With it (2026-12-02,
+seeds 0..7 at 60 s, side by side): cuts on 7 of 8 (seed 5 proven in 49 s: 32 cuts, root LP
+56.35 -> 56.13, 5 nodes), cuts off 6 of 8; K = 6 (seeds 0..3) unchanged: the root converges
+too late (45-55 s) for cuts to start, bounds 89, 96, 98 either way.
 """
 
 from __future__ import annotations
@@ -120,7 +123,7 @@ from formulations.plan import Plan, Result, Status
 from formulations.verify import verify
 
 TOL = 1e-6
-CUTS_FROM_S = 120.0  # time limits from which subset-row cuts are on by default
+CUTS_FROM_S = 60.0  # time limits from which subset-row cuts are on by default
 PRIMAL_SHARE = 0.1  # of the time limit for the caller's heuristic (``primal``) ...
 PRIMAL_CAP_S = 10.0  # ... but at most this many seconds
 STRONG = 5  # branching candidates compared by their children's restricted LPs
