@@ -788,6 +788,27 @@ def test_cuts_match_brute_force(seed):
         assert sum(inst.prizes[v] for v in r.plan.visited) == pytest.approx(best)
 
 
+@pytest.mark.parametrize("offset", [0.0, -1.0])
+def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset):
+    """The registered bp spends a moment on greedy before solve_bp; whether cuts are on follows
+    the user's time limit (at CUTS_FROM_S: on), not the slightly smaller one left for solve_bp."""
+    import heuristics.bp_warm as warm
+    from formulations.bp.branch_price import CUTS_FROM_S, default_cut_rounds
+    from formulations.plan import Result
+
+    limit = CUTS_FROM_S + offset
+    seen = {}
+
+    def fake_solve_bp(instance, **kw):
+        seen.update(kw)
+        return Result("bp", Status.TIME_LIMIT, runtime_s=0.0, reason="stub")
+
+    monkeypatch.setattr(warm, "solve_bp", fake_solve_bp)
+    warm.bp(random_tiny(0, groups=False), time_limit=limit)
+    assert seen["time_limit"] < limit
+    assert seen["cut_rounds"] == default_cut_rounds(limit) == (6 if limit >= CUTS_FROM_S else 0)
+
+
 def test_cuts_are_on_by_default_for_long_runs_only():
     """Cuts slow pricing down; by default they are used from CUTS_FROM_S seconds (and without a
     limit) and can be forced either way."""

@@ -129,6 +129,13 @@ PRIMAL_CAP_S = 10.0  # ... but at most this many seconds
 STRONG = 5  # branching candidates compared by their children's restricted LPs
 
 
+def default_cut_rounds(time_limit: float | None) -> int:
+    """Rounds of subset-row cuts by default: 6 from ``CUTS_FROM_S`` (and without a limit), else
+    0 (cuts only pay back their slower pricing on long runs). A caller that spends part of the
+    user's limit before :func:`solve_bp` decides on the user's limit."""
+    return 6 if time_limit is None or float(time_limit) >= CUTS_FROM_S else 0
+
+
 @dataclass(frozen=True)
 class NodeState:
     """Branching decisions of one branch-and-bound node (solver points: node id + 1)."""
@@ -190,10 +197,7 @@ class BranchAndPrice:
         self.root_cert = None  # (duals, their dual term, best reduced prize bound, bound)
         self._arc_cert = None  # (root_cert the arc bounds belong to, arc bounds - vehicle dual)
         self.elim_version = 0  # bumped whenever more arcs are eliminated
-        if cut_rounds is None:  # auto: cuts only pay back their slower pricing on long runs
-            long_run = time_limit is None or float(time_limit) >= CUTS_FROM_S
-            cut_rounds = 6 if long_run else 0
-        self.cut_rounds = cut_rounds
+        self.cut_rounds = default_cut_rounds(time_limit) if cut_rounds is None else cut_rounds
         self.cut_gap = cut_gap
         self.cuts_per_round = cuts_per_round
         self.cut_round = 0
