@@ -329,8 +329,8 @@ def test_label_arc_bounds_cover_every_path_above_the_threshold(seed, ng_size):
     paths = _brute_paths(cost, profit, budget)
     prizes = sorted(p for p, _ in paths)
     threshold = prizes[len(prizes) * 3 // 4]
-    best = label_arc_bounds(cost, profit, allowed, budget, nearest_ng(cost, ng_size), threshold,
-                            units=64)
+    best, routes = label_arc_bounds(cost, profit, allowed, budget, nearest_ng(cost, ng_size),
+                                    threshold, units=64, n_routes=5)
     dp = arc_bounds(cost, profit, allowed, budget, units=64)
     above = np.zeros((n, n), dtype=bool)
     for prize, path in paths:
@@ -343,6 +343,14 @@ def test_label_arc_bounds_cover_every_path_above_the_threshold(seed, ng_size):
     assert above.any() and not above.all()
     if ng_size == 8:
         assert np.any(best < dp - 1e-6)
+    # its routes: elementary paths above the threshold (distinct sets, best first, the best one
+    # among them; labels the dominance removed take their routes with them)
+    above_paths = {p for pr, p in paths if pr > threshold}
+    got = [float(profit[list(r)].sum()) for r in routes]
+    assert 0 < len(routes) <= 5 and len({frozenset(r) for r in routes}) == len(routes)
+    assert all(tuple(r) in above_paths for r in routes)
+    assert got == sorted(got, reverse=True)
+    assert got[0] == pytest.approx(max(pr for pr, _ in paths))
 
 
 def test_suffix_tables_are_the_best_walk_without_turning_back():

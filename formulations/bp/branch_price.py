@@ -127,6 +127,7 @@ CUTS_FROM_S = 60.0  # time limits from which subset-row cuts are on by default
 PRIMAL_SHARE = 0.1  # of the time limit for the caller's heuristic (``primal``) ...
 PRIMAL_CAP_S = 10.0  # ... but at most this many seconds
 STRONG = 5  # branching candidates compared by their children's restricted LPs
+POOL_ROUTES = 2000  # near-optimal routes from the root's labelling arc bounds, for the MILP
 
 
 def default_cut_rounds(time_limit: float | None) -> int:
@@ -177,6 +178,7 @@ class _Stats:
     arcs_eliminated: int = 0  # arcs no plan better than the incumbent can use
     elim_s: float = 0.0  # time spent on their bounds
     elim_labels: bool | None = None  # the labelling bound ran to the end (None: not tried)
+    pool_routes: int = 0  # routes its search added to the master
     root_lp: float | None = None  # restricted root LP value when cuts were first considered
     pricing_s: float = 0.0
     lp_s: float = 0.0
@@ -669,7 +671,9 @@ class BranchAndPrice:
         always; with ``labels`` (once the root is solved) also :func:`label_arc_bounds` on the
         arcs the DP leaves (exact ng-labelling both ways, about as costly as two exact pricing
         calls, much tighter). The labelling bound only covers the paths above its threshold, so
-        it stays valid as the incumbent, and with it the floor, rises."""
+        it stays valid as the incumbent, and with it the floor, rises. Its forward search also
+        yields the ``POOL_ROUTES`` best elementary routes that a better plan may use; they join
+        the master as columns, so that the MILP over the generated routes can combine them."""
         floor = self._rc_floor()
         if floor is None:
             return
@@ -684,9 +688,12 @@ class BranchAndPrice:
             if labels:
                 cost[through - y[0] < floor] = np.inf
                 exact = label_arc_bounds(cost, prof, allowed, self.budget, self.ng, y[0] + floor,
-                                         deadline=min(self.deadline, t + self.elim_limit))
+                                         deadline=min(self.deadline, t + self.elim_limit),
+                                         n_routes=POOL_ROUTES)
                 if exact is not None:
-                    through = np.minimum(through, exact)
+                    through = np.minimum(through, exact[0])
+                    # the same search's best routes: near-optimal columns for the MILP
+                    self.stats.pool_routes = self.master.add_routes(exact[1])
                 self.stats.elim_labels = exact is not None
             self.stats.elim_s += time.perf_counter() - t
             self._arc_cert = (self.root_cert, through - y[0], labels)
@@ -833,6 +840,7 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
         "open_nodes": st.open_nodes,
         "cuts": st.cuts, "cuts_purged": st.cuts_purged, "arcs_eliminated": st.arcs_eliminated,
         "elim_s": round(st.elim_s, 3), "elim_labels": st.elim_labels,
+        "pool_routes": st.pool_routes,
         "root_lp": st.root_lp, "primal_s": st.primal_s, "primal_prize": st.primal_prize,
         "primal_improved": st.primal_improved, "primal_error": st.primal_error,
         "pricing_s": round(st.pricing_s, 3), "lp_s": round(st.lp_s, 3),

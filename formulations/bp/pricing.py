@@ -687,13 +687,16 @@ def _reversed(cost, profit, allowed):
             np.ascontiguousarray(profit[perm]), allowed[perm])
 
 
-def _label_table(cost, profit, budget, ng, allowed, threshold, max_labels, deadline, delta, nb):
+def _label_table(cost, profit, budget, ng, allowed, threshold, max_labels, deadline, delta, nb,
+                 n_routes=0):
     """``t[v, b]``: the best prize of a label at v of energy <= b units, over the labels of a
-    one-way exact ng-labelling with the fixed ``threshold`` (None if it hit a cap)."""
+    one-way exact ng-labelling with the fixed ``threshold``, and up to ``n_routes`` elementary
+    routes above the threshold (best first, one per set of points); None if it hit a cap."""
     n = cost.shape[0]
+    end = n - 1
     ret = cheapest_return(cost)
     order, cin, reach, lastord, cend = _prepare(cost, ret, profit, allowed)
-    count, node, _, en, pr, _, _, hit, _ = _label(
+    count, node, pred, en, pr, _, _, hit, _ = _label(
         cost, ret, profit, budget, ng, allowed, False, max_labels, order, cin, reach, lastord,
         cend, float(threshold), float(deadline), float(budget), np.zeros(n, np.uint64),
         np.zeros(n, np.uint64), np.zeros((8, 256)), *suffix_tables(cost, profit, allowed, budget),
@@ -704,18 +707,32 @@ def _label_table(cost, profit, budget, ng, allowed, threshold, max_labels, deadl
     table = np.full((n, nb + 1), -np.inf)
     units = np.minimum((en / delta + 1e-9).astype(np.int64), nb)
     np.maximum.at(table, (node, units), pr)
-    return np.maximum.accumulate(table, axis=1)
+    routes, sets = [], set()
+    done = (node > 0) & (en + cost[node, end] <= budget) & (pr > threshold)
+    cand = np.flatnonzero(done)
+    for li in cand[np.argsort(-pr[cand], kind="stable")]:
+        if len(routes) >= n_routes:
+            break
+        path = tuple(_chain(node, pred, int(li)))
+        key = frozenset(path)
+        if len(key) == len(path) and key not in sets:
+            sets.add(key)
+            routes.append(path)
+    return np.maximum.accumulate(table, axis=1), routes
 
 
 def label_arc_bounds(cost, profit, allowed, budget, ng, threshold, *, max_labels=2_000_000,
-                     deadline=np.inf, units: int = DP_UNITS):
+                     deadline=np.inf, units: int = DP_UNITS, n_routes: int = 0):
     """Like :func:`arc_bounds`, from exact ng-labelling instead of the 2-cycle-free DP: the
     prefix table from one-way labels start -> i, the suffix table from labels of the reversed
     graph, over the whole budget, with completion-bound pruning against the fixed
     ``threshold``. Exact for what it is used for: every elementary path through (i, j) with a
     prize above ``threshold`` is bounded by ``best[i, j]`` (each prefix of such a path is a
     label or dominated by one, which has no less prize and no more energy); arcs of no such path
-    get a value <= ``threshold``. None when a search hit ``max_labels`` or the ``deadline``."""
+    get a value <= ``threshold``. Returns (best, routes): ``routes`` are up to ``n_routes``
+    elementary routes above the threshold from the forward labels, best first, one per set of
+    points (near-optimal columns for a MILP). None when a search hit ``max_labels`` or the
+    ``deadline``."""
     n = cost.shape[0]
     end = n - 1
     profit = np.ascontiguousarray(profit, dtype=np.float64)
@@ -723,19 +740,21 @@ def label_arc_bounds(cost, profit, allowed, budget, ng, threshold, *, max_labels
     if nb == 0:
         return None
     fwd = _label_table(np.ascontiguousarray(cost), profit, budget, ng, allowed, threshold,
-                       max_labels, deadline, delta, nb)
+                       max_labels, deadline, delta, nb, n_routes)
     if fwd is None:
         return None
+    prefix, routes = fwd
     perm, cost_b, profit_b, allowed_b = _reversed(cost, profit, allowed)
     bwd = _label_table(cost_b, profit_b, budget, ng, allowed_b, threshold, max_labels,
                        deadline, delta, nb)
     if bwd is None:
         return None
-    prefix, suffix = fwd, bwd[perm]  # labels count their own point's prize
+    suffix = bwd[0][perm]  # labels count their own point's prize
     prefix[0] = 0.0
     suffix[end] = 0.0
-    return _through_arcs(np.ascontiguousarray(cost), np.ascontiguousarray(prefix),
+    best = _through_arcs(np.ascontiguousarray(cost), np.ascontiguousarray(prefix),
                          np.ascontiguousarray(suffix), np.zeros(n), delta, nb)
+    return best, routes
 
 
 def _chain(node, pred, j):
