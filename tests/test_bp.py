@@ -21,15 +21,19 @@ TOP_DIR = Path(__file__).resolve().parent.parent / "benchmarks" / "instances" / 
 OPTIMAL = {r["instance"]: float(r["value"]) for r in csv.DictReader(open(TOP_DIR / "optimal.csv"))}
 
 
-def brute_force(inst: TOPInstance) -> float | None:
-    """Best prize over all plans of a tiny instance (None if no plan covers every group)."""
-    v = inst.n_nodes
+def _feasible_routes(inst: TOPInstance) -> list[tuple[int, ...]]:
+    """Every route (node ids in visiting order, the empty one included) within the budget."""
     routes = [()]
-    for k in range(1, v + 1):
-        for perm in itertools.permutations(range(v), k):
+    for k in range(1, inst.n_nodes + 1):
+        for perm in itertools.permutations(range(inst.n_nodes), k):
             if route_energy(inst, perm) <= inst.budget * (1 + 1e-9):
                 routes.append(perm)
-    sets = {frozenset(r) for r in routes}
+    return routes
+
+
+def brute_force(inst: TOPInstance) -> float | None:
+    """Best prize over all plans of a tiny instance (None if no plan covers every group)."""
+    sets = {frozenset(r) for r in _feasible_routes(inst)}
     best = None
     for combo in itertools.combinations_with_replacement(sorted(sets, key=sorted), inst.n_vehicles):
         nodes = [i for s in combo for i in s]
@@ -253,6 +257,19 @@ def test_completion_bound_covers_every_suffix(seed):
             assert ub >= best_suffix - 1e-9
 
 
+def _branch_like(cost: np.ndarray, seed: int) -> None:
+    """A branching-like graph, in place: a few forbidden arcs, a few arcs made cheaper (no
+    triangle inequality any more)."""
+    rng = np.random.default_rng(seed)
+    n = cost.shape[0]
+    for a, b in rng.integers(1, n - 1, size=(4, 2)):
+        if a != b:
+            cost[a, b] = np.inf
+    for a, b in rng.integers(1, n - 1, size=(3, 2)):
+        if a != b and np.isfinite(cost[a, b]):
+            cost[a, b] *= 0.5
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_suffix_tables_cover_every_suffix(seed):
     """The DP suffix bound never undercuts the best elementary suffix of a path prefix
@@ -260,15 +277,8 @@ def test_suffix_tables_cover_every_suffix(seed):
     from formulations.bp.pricing import _dp_bound, suffix_tables
 
     cost, ret, profit, budget = _tiny_pricing(seed)
-    if seed >= 2:  # branching-like graph: a few forbidden arcs, a few arcs made cheaper
-        rng = np.random.default_rng(100 + seed)
-        n = cost.shape[0]
-        for a, b in rng.integers(1, n - 1, size=(4, 2)):
-            if a != b:
-                cost[a, b] = np.inf
-        for a, b in rng.integers(1, n - 1, size=(3, 2)):
-            if a != b and np.isfinite(cost[a, b]):
-                cost[a, b] *= 0.5
+    if seed >= 2:
+        _branch_like(cost, 100 + seed)
     n = cost.shape[0]
     g1, s1, g2, delta, nb = suffix_tables(cost, profit, np.ones(n, dtype=bool), budget, units=64)
     assert nb > 0
@@ -296,13 +306,7 @@ def test_arc_bounds_cover_every_path_through_an_arc(seed):
     cost, ret, profit, budget = _tiny_pricing(seed)
     n = cost.shape[0]
     if seed >= 2:
-        rng = np.random.default_rng(200 + seed)
-        for a, b in rng.integers(1, n - 1, size=(4, 2)):
-            if a != b:
-                cost[a, b] = np.inf
-        for a, b in rng.integers(1, n - 1, size=(3, 2)):
-            if a != b and np.isfinite(cost[a, b]):
-                cost[a, b] *= 0.5
+        _branch_like(cost, 200 + seed)
     best = arc_bounds(cost, profit, np.ones(n, dtype=bool), budget, units=64)
     exact = np.full((n, n), -np.inf)
     for prize, path in _brute_paths(cost, profit, budget):
@@ -833,13 +837,8 @@ def test_cuts_are_on_by_default_for_long_runs_only():
 def _arcs_of_plans_from(inst: TOPInstance, value: float) -> set:
     """Arcs (solver points: start 0, nodes 1..V, end V+1) of every plan worth at least ``value``."""
     v = inst.n_nodes
-    routes = [()]
-    for k in range(1, v + 1):
-        for perm in itertools.permutations(range(v), k):
-            if route_energy(inst, perm) <= inst.budget * (1 + 1e-9):
-                routes.append(perm)
     arcs = set()
-    for combo in itertools.combinations(routes, inst.n_vehicles):
+    for combo in itertools.combinations(_feasible_routes(inst), inst.n_vehicles):
         nodes = [i for r in combo for i in r]
         if len(nodes) != len(set(nodes)) or inst.prizes[nodes].sum() < value - 1e-9:
             continue
