@@ -97,6 +97,14 @@ seeds 0..7, 60 s through the registry, one thread):
   by side with and without strong branching, and in the reference suite: seed 4 proven in
   27 s, seeds 1 and 5 open); seed 5 at 300 s proven in 178 s with cuts (default) and in 134 s
   with cuts off; K = 6 bounds and incumbents as above.
+- 2026-12-02, with arc elimination (6.), the labelling's best routes as MILP columns and cuts
+  from 60 s: **8 of 8 proven at 60 s** in two batches through the registry (plans verified):
+  two processes side by side 27.6, 8.9, 38.3, 10.9, 50.0, 15.9, 24.1, 15.2 s (seeds 0..7); one
+  process beside a K = 6 batch 10.6, 21.3, 46.6, 14.3, 17.6, 47.8, 25.6, 15.2 s. Seed 5 closes
+  through 32 cuts (root LP 56.35 -> 56.13, 5 nodes); on seeds 1 and 4 the root MILP over the
+  pool finds the optimum (57, 53) that PyVRP (56, 52, with any of 6 seeds), the dives and 60 s
+  of branching had missed. K = 6 (seeds 0..4): bounds 89, 96, 98, 100, 89 as before, since the
+  root converges only at 40-55 s.
 
 Subset-row cuts are off below ``CUTS_FROM_S`` (60 s): on a 30-viewpoint instance they once
 turned a 2 s proof into 22 s. Before arc elimination the threshold was 120 s (at 60 s, side by
