@@ -205,7 +205,7 @@ class BranchAndPrice:
         self.primal = primal
         self.strong = strong
         self.root_cert = None  # (duals, their dual term, best reduced prize bound, bound)
-        self._arc_cert = None  # (root_cert the arc bounds belong to, arc bounds - vehicle dual)
+        self._arc_cert = None  # (root_cert the arc bounds belong to, arc bounds, labelled?)
         self.elim_version = 0  # bumped whenever more arcs are eliminated
         self.cut_rounds = default_cut_rounds(time_limit) if cut_rounds is None else cut_rounds
         self.cut_gap = cut_gap
@@ -691,8 +691,8 @@ class BranchAndPrice:
             y = self.root_cert[0]
             cost, _, allowed = self._node_graph(NodeState())
             prof = self.master.point_profit(y)
-            through = self._arc_cert[1] + y[0] if cached else arc_bounds(cost, prof, allowed,
-                                                                          self.budget)
+            through = self._arc_cert[1] if cached else arc_bounds(cost, prof, allowed,
+                                                                   self.budget)
             if labels:
                 cost[through - y[0] < floor] = np.inf
                 exact = label_arc_bounds(cost, prof, allowed, self.budget, self.ng, y[0] + floor,
@@ -704,9 +704,10 @@ class BranchAndPrice:
                     self.stats.pool_routes = self.master.add_routes(exact[1])
                 self.stats.elim_labels = exact is not None
             self.stats.elim_s += time.perf_counter() - t
-            self._arc_cert = (self.root_cert, through - y[0], labels)
+            self._arc_cert = (self.root_cert, through, labels)
         m = self.master
-        new = (self._arc_cert[1] < floor) & ~m.eliminated & np.isfinite(self.cost)
+        y0 = self.root_cert[0][0]
+        new = (self._arc_cert[1] - y0 < floor) & ~m.eliminated & np.isfinite(self.cost)
         new[:, 0] = new[-1, :] = False
         np.fill_diagonal(new, False)
         if new.any():

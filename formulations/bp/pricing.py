@@ -625,8 +625,10 @@ def _dp_unit(cost, budget, units):
 @njit(cache=True)
 def _through_arcs(cost, prefix, suffix, profit, delta, nb):
     """``best[i, j]``: max over unit splits of prefix[i, b1] + suffix[j, b2] with
-    b1 + units(i, j) + b2 <= nb, plus the prizes of i and j (-inf where nothing fits)."""
+    b1 + units(i, j) + b2 <= nb, plus the prizes of i and j (-inf where nothing fits). The
+    start's prefix and the end's suffix are empty (0), whatever their table rows say."""
     n = cost.shape[0]
+    end = n - 1
     best = np.full((n, n), -np.inf)
     for i in range(n - 1):
         for j in range(1, n):
@@ -639,10 +641,10 @@ def _through_arcs(cost, prefix, suffix, profit, delta, nb):
             r = nb - q
             v = -np.inf
             for b1 in range(r + 1):
-                a = prefix[i, b1]
+                a = prefix[i, b1] if i > 0 else 0.0
                 if a == -np.inf:
                     continue
-                s = a + suffix[j, r - b1]
+                s = a + (suffix[j, r - b1] if j < end else 0.0)
                 if s > v:
                     v = s
             if v > -np.inf:
@@ -662,20 +664,15 @@ def arc_bounds(cost, profit, allowed, budget, units: int = DP_UNITS):
     join may turn back at i or j: that only admits more walks). Used for reduced-cost arc
     elimination."""
     n = cost.shape[0]
-    end = n - 1
     profit = np.ascontiguousarray(profit, dtype=np.float64)
     delta, nb = _dp_unit(cost, budget, units)
     if nb == 0:
         return np.full((n, n), np.inf)
-    g1, _, _ = _suffix_dp(cost, profit, allowed, delta, nb)
+    suffix, _, _ = _suffix_dp(cost, profit, allowed, delta, nb)
     perm, cost_b, profit_b, allowed_b = _reversed(cost, profit, allowed)
     h1, _, _ = _suffix_dp(cost_b, profit_b, allowed_b, delta, nb)
-    prefix = h1[perm]  # prefix[i, b]: start -> ... -> i (i's own prize not counted)
-    prefix[0] = 0.0  # the start: an empty prefix
-    suffix = g1.copy()
-    suffix[end] = 0.0
-    return _through_arcs(np.ascontiguousarray(cost), np.ascontiguousarray(prefix),
-                         np.ascontiguousarray(suffix), profit, delta, nb)
+    prefix = np.ascontiguousarray(h1[perm])  # start -> ... -> i (i's own prize not counted)
+    return _through_arcs(np.ascontiguousarray(cost), prefix, suffix, profit, delta, nb)
 
 
 def _reversed(cost, profit, allowed):
@@ -734,7 +731,6 @@ def label_arc_bounds(cost, profit, allowed, budget, ng, threshold, *, max_labels
     points (near-optimal columns for a MILP). None when a search hit ``max_labels`` or the
     ``deadline``."""
     n = cost.shape[0]
-    end = n - 1
     profit = np.ascontiguousarray(profit, dtype=np.float64)
     delta, nb = _dp_unit(cost, budget, units)
     if nb == 0:
@@ -749,11 +745,8 @@ def label_arc_bounds(cost, profit, allowed, budget, ng, threshold, *, max_labels
                        deadline, delta, nb)
     if bwd is None:
         return None
-    suffix = bwd[0][perm]  # labels count their own point's prize
-    prefix[0] = 0.0
-    suffix[end] = 0.0
-    best = _through_arcs(np.ascontiguousarray(cost), np.ascontiguousarray(prefix),
-                         np.ascontiguousarray(suffix), np.zeros(n), delta, nb)
+    suffix = np.ascontiguousarray(bwd[0][perm])  # labels count their own point's prize
+    best = _through_arcs(np.ascontiguousarray(cost), prefix, suffix, np.zeros(n), delta, nb)
     return best, routes
 
 
