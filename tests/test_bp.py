@@ -864,3 +864,33 @@ def test_arc_elimination_keeps_every_better_plan(seed):
     gone = {(int(a), int(b)) for a, b in zip(*np.nonzero(bp.master.eliminated))}
     assert gone and bp.stats.elim_labels
     assert not gone & _arcs_of_plans_from(inst, best)
+
+
+def test_labelling_arc_bounds_run_before_the_first_cut_round():
+    """With cuts on, the root's labelling arc elimination runs before any cut is separated, so
+    the cut rounds price on the smaller graph; the published optimum is still proven."""
+    from formulations.bp.branch_price import BranchAndPrice
+
+    events = []
+
+    class Recording(BranchAndPrice):
+        def _eliminate_arcs(self, labels=False):
+            before = self.stats.arcs_eliminated
+            super()._eliminate_arcs(labels)
+            if labels:
+                events.append(("labels", self.stats.arcs_eliminated - before))
+
+        def _add_cuts(self, state, x, y, lp_value):
+            cuts = self.stats.cuts
+            out = super()._add_cuts(state, x, y, lp_value)
+            if self.stats.cuts > cuts:
+                events.append(("cuts", self.stats.cuts - cuts))
+            return out
+
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    bp = Recording(inst, time_limit=60, cut_rounds=4, cut_gap=100.0, cut_share=1.0)
+    proven, bound = bp.run()
+    kinds = [k for k, _ in events]
+    assert "cuts" in kinds and "labels" in kinds
+    assert kinds.index("labels") < kinds.index("cuts")
+    assert proven and bound == pytest.approx(OPTIMAL["p2.2.k"])
