@@ -43,7 +43,7 @@ labelling pricing (:mod:`.pricing`):
    of the 3600 arcs go at the root (all of them once the incumbent is optimal); pricing, LPs and
    strong branching get faster. Labelling before the cuts (2026-12-02, seeds 0..7 at 60 s, two
    processes side by side, before/after): 33.0/12.7, 22.4/23.3, 38.3/38.2, 10.4/11.5,
-   16.1/14.5, 48.6/47.9, 23.9/20.1 s on seeds 0..6 (seed 7's baseline was cut off; 16.2 s after).
+   16.1/14.5, 48.6/47.9, 23.9/20.1, 16.4/16.2 s on seeds 0..7 (all 8 proven either way).
 
 Branching, in order: on a fractional node visit (forbid the node / force it visited: a forced node
 row becomes ``= 1``); then, when all visits are integral, on a fractional arc flow (forbid the arc
