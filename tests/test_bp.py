@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import itertools
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -894,3 +895,25 @@ def test_labelling_arc_bounds_run_before_the_first_cut_round():
     assert "cuts" in kinds and "labels" in kinds
     assert kinds.index("labels") < kinds.index("cuts")
     assert proven and bound == pytest.approx(OPTIMAL["p2.2.k"])
+
+
+def test_root_out_of_time_right_after_the_route_pool_joined():
+    """The labelling's route pool adds columns to the master after the root LP was solved; when
+    the time runs out right then (no re-solve, no dive), the root's LP solution must still match
+    the master's columns. It used not to (a ValueError at M = 20, K = 6 in loaded runs); now the
+    run stops with a valid bound."""
+    from formulations.bp.branch_price import BranchAndPrice
+
+    class OutOfTime(BranchAndPrice):
+        def _eliminate_arcs(self, labels=False):
+            before = self.master.n_routes
+            super()._eliminate_arcs(labels)
+            if labels:
+                self.pool_added = self.master.n_routes - before
+                self.deadline = self.hard_deadline = time.perf_counter() - 1.0
+
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    bp = OutOfTime(inst, time_limit=60, cut_rounds=0)
+    proven, bound = bp.run()
+    assert bp.pool_added > 0  # the pool did add columns after the root LP
+    assert not proven and bound >= OPTIMAL["p2.2.k"] - 1e-6

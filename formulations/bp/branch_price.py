@@ -508,10 +508,10 @@ class BranchAndPrice:
         if not self.labelled_before_cuts:
             # the labelling arc bounds first: cut rounds then price on the smaller graph
             self.labelled_before_cuts = True
-            version = self.elim_version
+            version, k = self.elim_version, self.master.n_routes
             self._eliminate_arcs(labels=True)
-            if self.elim_version != version:
-                return True  # re-solve on the smaller graph, then separate
+            if self.elim_version != version or self.master.n_routes != k:
+                return True  # re-solve (smaller graph, the route pool), then separate
         self.cut_round += 1
         if len(self.master.cuts) + self.cuts_per_round > MAX_CUTS:  # make room: drop idle cuts
             purged = self.master.purge_cuts(y)
@@ -766,6 +766,11 @@ class BranchAndPrice:
                 self._eliminate_arcs(labels=True)
                 if self.elim_version != version and self._time_left() > 0:
                     bound, x, xa, converged = self.column_generation(state, bound)
+                elif len(x) != self.master.n_routes:
+                    # the route pool joined after the LP was solved (and no time is left to
+                    # re-solve the root): the LP solution over all of the master's columns
+                    self.master.apply(state)
+                    _, x, xa, _ = self.master.solve()
             if state.depth == 0:
                 self.stats.root_bound = bound if math.isfinite(bound) else None
                 self.stats.root_s = time.perf_counter() - self.t0
