@@ -37,6 +37,7 @@ from pathlib import Path
 
 from formulations.errors import SarcoverError
 from reports.results import RESULTS_FILE, SCHEMA_VERSION, read_rows
+from benchmarks.registry import get_method, warm_up
 from benchmarks.suite import Suite
 
 _PACKAGES = ("sarcover", "numpy", "scipy", "pandas", "scikit-learn", "pyomo", "highspy", "ortools",
@@ -450,6 +451,23 @@ def run_local(jobs: list[dict], emit, *, workers: int, memory_mb: int = 0) -> No
                     w.kill()
 
 
+def _warm_up(methods, stream) -> None:
+    """Compile the numba code of the suite's methods in the parent, before the workers fork:
+    they inherit it, so no job pays for it (the first bp job on a fresh checkout used to spend
+    ~26 s of its time limit compiling, enough for the harness to kill a 60 s job). numba keeps
+    the compiled code on disk, so later runs load it in well under a second."""
+    hooks = {get_method(m).warm_up for m in methods} - {None}
+    if not hooks:
+        return
+    if stream is not None:
+        stream.write("compiling numba code (cached on disk after the first run) ... ")
+        stream.flush()
+    t = time.monotonic()
+    warm_up(methods)
+    if stream is not None:
+        stream.write(f"{time.monotonic() - t:.1f} s\n")
+
+
 # -- Dask -----------------------------------------------------------------------------------------
 def run_one_guarded(job: dict) -> dict:
     """run_one with a soft deadline, for Dask workers (threads cannot be killed; see module doc)."""
@@ -475,8 +493,9 @@ def connect(address: str):
         raise HarnessError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
 
 
-def run_dask(jobs: list[dict], emit, *, scheduler) -> None:
-    """Run ``jobs`` on a Dask cluster (an address like ``tcp://host:8786`` or a Client)."""
+def run_dask(jobs: list[dict], emit, *, scheduler, warm=()) -> None:
+    """Run ``jobs`` on a Dask cluster (an address like ``tcp://host:8786`` or a Client). The
+    methods in ``warm`` compile their numba code on every worker first (see :func:`_warm_up`)."""
     if not jobs:
         return
     from dask.distributed import Client, as_completed
@@ -484,6 +503,11 @@ def run_dask(jobs: list[dict], emit, *, scheduler) -> None:
     own = not isinstance(scheduler, Client)
     client = connect(scheduler) if own else scheduler
     try:
+        if warm:
+            try:
+                client.run(warm_up, list(warm))
+            except Exception:  # noqa: BLE001 - a worker that cannot warm up compiles in its job
+                pass
         futures = {}
         for job in jobs:
             futures[client.submit(run_one_guarded, job, pure=False)] = job
@@ -544,9 +568,11 @@ def _run_suite(suite, out_dir, workers, resume, scheduler, address, progress, st
 
         t0 = time.monotonic()
         started = _now()
+        methods = sorted({job["method"] for job in payload})
         if scheduler:
-            run_dask(payload, emit, scheduler=scheduler)
+            run_dask(payload, emit, scheduler=scheduler, warm=methods)
         else:
+            _warm_up(methods, stream if progress else None)
             run_local(payload, emit, workers=workers, memory_mb=suite.memory_mb)
         wall = time.monotonic() - t0
         with (store.directory / "runs.jsonl").open("a") as fh:

@@ -21,6 +21,7 @@ from __future__ import annotations
 import time
 
 from formulations.bp import default_cut_rounds, solve_bp
+from formulations.bp.pricing import warm_up
 from formulations.history import shifted
 from formulations.plan import Result, Status
 from heuristics.greedy import greedy
@@ -42,6 +43,7 @@ def _pyvrp_routes(instance, seed: int):
 def bp(instance, *, seed: int = 0, time_limit: float | None = 60.0) -> Result:
     """`bp` with greedy's routes (when it finds a plan) as initial columns and incumbent, and
     PyVRP as the heuristic run once the root has not proven the incumbent."""
+    warm_up()  # numba compilation (or loading it from the disk cache) is not the method's time
     t0 = time.perf_counter()
     cut_rounds = default_cut_rounds(time_limit)  # on the user's limit, not what greedy leaves
     start = greedy(instance, seed=seed)

@@ -323,3 +323,82 @@ def test_ctrl_c_in_a_worker_stops_the_run_without_storing_its_job(tmp_path, caps
     assert main(["bench", str(suite), "-o", str(out), "--workers", "1", "--quiet"]) == 130
     text = (out / "results.jsonl").read_text() if (out / "results.jsonl").exists() else ""
     assert "interrupted" not in text
+
+
+WARM_CHECK = r"""
+import json, sys
+from numba.core.registry import CPUDispatcher
+import formulations.bp.pricing as pricing
+import heuristics.kernels as kernels
+from benchmarks.registry import METHODS, run_method, warm_up
+from formulations.generate import generate
+from formulations.instance import to_top
+
+def compiled():
+    out = {}
+    for mod in (pricing, kernels):
+        for name in dir(mod):
+            f = getattr(mod, name)
+            if isinstance(f, CPUDispatcher):
+                out[f"{mod.__name__}.{name}"] = len(f.signatures)
+    return out
+
+before = compiled()
+hooks = warm_up(list(METHODS))
+warmed = compiled()
+inst = to_top(generate(6, 3, 2, seed=1))
+statuses = {m: str(run_method(m, inst, seed=0, time_limit=10)[0].status)
+            for m in ("bp", "adpc-pso", "dpc-pso", "kmeans-pso", "adpc-ga", "adpc-aco")}
+print(json.dumps({"before": before, "hooks": hooks, "warmed": warmed, "after": compiled(),
+                  "statuses": statuses}))
+"""
+
+
+def test_warm_up_leaves_nothing_for_the_jobs_to_compile():
+    """In a fresh process, the registry's warm-up hooks compile (or load from numba's disk cache)
+    every numba function that bp and the paper's pipelines then call: running them afterwards
+    adds no compiled signature. That is what keeps JIT compilation out of a job's time."""
+    out = subprocess.run([sys.executable, "-c", WARM_CHECK], cwd=ROOT, capture_output=True,
+                         text=True, timeout=600, check=True)
+    data = json.loads(out.stdout.strip().splitlines()[-1])
+    assert sorted(data["hooks"]) == ["formulations.bp.pricing:warm_up", "heuristics.pipeline:warm_up"]
+    assert sum(data["before"].values()) == 0  # a fresh process: nothing compiled yet
+    assert data["warmed"]["formulations.bp.pricing._label"] > 0
+    assert data["warmed"]["heuristics.kernels.pso_iterations"] > 0
+    assert data["after"] == data["warmed"]
+    assert set(data["statuses"].values()) <= {"optimal", "feasible"}
+
+
+def test_warm_up_runs_each_hook_once_and_skips_a_broken_one(monkeypatch):
+    import benchmarks.registry as registry
+
+    calls = []
+    monkeypatch.setattr(registry, "_WARMED", set())
+    monkeypatch.setattr(registry, "_resolve", lambda target: (lambda: calls.append(target)))
+    assert registry.warm_up(["adpc-pso", "dpc-pso", "greedy", "bp", "tests.x:y"]) == [
+        "heuristics.pipeline:warm_up", "formulations.bp.pricing:warm_up"]
+    assert registry.warm_up(["adpc-ga", "bp"]) == []  # already done in this process
+    assert len(calls) == 2
+
+    def broken(target):
+        raise ImportError("no such module")
+
+    monkeypatch.setattr(registry, "_WARMED", set())
+    monkeypatch.setattr(registry, "_resolve", broken)
+    assert registry.warm_up(["bp"]) == []  # the job itself will report the problem
+
+
+def test_suite_with_jit_methods_compiles_before_the_workers_start(tmp_path):
+    """The harness warms up in the parent (the workers fork from it) and says so on its stream;
+    a suite without numba methods does not."""
+    import io
+
+    jit = write_suite(tmp_path, SMALL.replace('["greedy", "cpsat"]', '["greedy", "adpc-pso"]'), "jit.toml")
+    stream = io.StringIO()
+    run_suite(load_suite(str(jit)), tmp_path / "jit", workers=2, stream=stream)
+    assert "compiling numba code" in stream.getvalue()
+    assert all(r["status"] == "feasible" for r in rows_of(tmp_path / "jit"))
+    plain = write_suite(tmp_path, SMALL.replace('["greedy", "cpsat"]', '["greedy"]'), "plain.toml")
+    stream = io.StringIO()
+    run_suite(load_suite(str(plain)), tmp_path / "plain", workers=2, stream=stream)
+    assert "compiling" not in stream.getvalue()
