@@ -402,3 +402,34 @@ def test_suite_with_jit_methods_compiles_before_the_workers_start(tmp_path):
     stream = io.StringIO()
     run_suite(load_suite(str(plain)), tmp_path / "plain", workers=2, stream=stream)
     assert "compiling" not in stream.getvalue()
+
+
+def test_own_folder_of_instance_files_gives_share_proven_and_certified_gaps(tmp_path):
+    """The README's recipe for TOP sets 4-7 (not shipped): a suite naming a folder of instance
+    files of its own (no published optima next to them). The report counts what bp proves per
+    size and bounds the gap of the runs it did not prove by their certified bound."""
+    import shutil
+
+    from benchmarks.suite import TOP_DIR
+    from formulations.generate import generate
+    from formulations.io import save_json
+
+    folder = tmp_path / "Set_own"
+    folder.mkdir()
+    shutil.copy(TOP_DIR / "p2.2.b.txt", folder)  # proven in well under a second
+    save_json(generate(20, 3, 5, seed=5), folder / "m20k3.json")  # bp needs 10-50 s for this one
+    suite = write_suite(tmp_path, 'name = "own"\nmethods = ["bp"]\ntime_limit = 1\n'
+                                  '[[instances]]\nfiles = ["Set_own/*"]\n')
+    out = tmp_path / "res"
+    assert main(["bench", str(suite), "-o", str(out), "--workers", "2", "--quiet"]) == 0
+    assert main(["report", str(out)]) == 0
+    rows = {r["kind"]: r for r in rows_of(out)}
+    assert all(r["reference"] is None for r in rows.values())  # no published value used
+    assert rows["top"]["status"] == "optimal"
+    sar = rows["sar"]
+    assert sar["status"] == "time_limit" and sar["valid"] and sar["bound"] > sar["objective"]
+    tto = pd.read_csv(out / "report" / "time_to_optimality.csv", index_col=0)
+    assert tto["optimal"].sum() == 1 and tto["runs"].sum() == 2
+    methods = pd.read_csv(out / "report" / "methods.csv", index_col=0)
+    assert methods.loc["bp", "gap_ub_n"] == 1
+    assert methods.loc["bp", "gap_ub_max"] == pytest.approx((sar["bound"] - sar["objective"]) / sar["bound"])
