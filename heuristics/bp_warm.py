@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import time
 
-from formulations.bp import default_cut_rounds, solve_bp
+from formulations.bp import default_cut_gap, default_cut_rounds, solve_bp
 from formulations.bp.pricing import warm_up
 from formulations.history import shifted
 from formulations.plan import Result, Status
@@ -45,14 +45,16 @@ def bp(instance, *, seed: int = 0, time_limit: float | None = 60.0) -> Result:
     PyVRP as the heuristic run once the root has not proven the incumbent."""
     warm_up()  # numba compilation (or loading it from the disk cache) is not the method's time
     t0 = time.perf_counter()
-    cut_rounds = default_cut_rounds(time_limit)  # on the user's limit, not what greedy leaves
+    # cuts on the user's limit, not on what greedy leaves of it
+    cut_rounds, cut_gap = default_cut_rounds(time_limit), default_cut_gap(time_limit)
     start = greedy(instance, seed=seed)
     routes = [list(r) for r in start.plan.routes] if start.status == Status.FEASIBLE else None
     t1 = time.perf_counter()
     if time_limit is not None:
         time_limit = max(time_limit - (t1 - t0), 0.0)
     result = solve_bp(instance, seed=seed, time_limit=time_limit, initial_routes=routes,
-                      primal=_pyvrp_routes(instance, seed), cut_rounds=cut_rounds)
+                      primal=_pyvrp_routes(instance, seed), cut_rounds=cut_rounds,
+                      cut_gap=cut_gap)
     result.runtime_s = time.perf_counter() - t0
     if "history" in result.info:  # times from this call, greedy included
         result.info["history"] = shifted(result.info["history"], t1 - t0)

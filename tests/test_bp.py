@@ -802,14 +802,18 @@ def test_cuts_match_brute_force(seed):
 
 
 @pytest.mark.parametrize("offset", [0.0, -1.0])
-def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset):
-    """The registered bp spends a moment on greedy before solve_bp; whether cuts are on follows
-    the user's time limit (at CUTS_FROM_S: on), not the slightly smaller one left for solve_bp."""
+@pytest.mark.parametrize("threshold", ["CUTS_FROM_S", "OPEN_CUTS_FROM_S"])
+def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, threshold):
+    """The registered bp spends a moment on greedy before solve_bp; whether cuts are on, and how
+    open their gate is, follow the user's time limit (at CUTS_FROM_S: on; at OPEN_CUTS_FROM_S:
+    open), not the slightly smaller one left for solve_bp."""
+    import formulations.bp.branch_price as branch_price
     import heuristics.bp_warm as warm
-    from formulations.bp.branch_price import CUTS_FROM_S, default_cut_rounds
+    from formulations.bp.branch_price import (CUTS_FROM_S, OPEN_CUTS_FROM_S, default_cut_gap,
+                                              default_cut_rounds)
     from formulations.plan import Result
 
-    limit = CUTS_FROM_S + offset
+    limit = getattr(branch_price, threshold) + offset
     seen = {}
 
     def fake_solve_bp(instance, **kw):
@@ -820,6 +824,7 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset):
     warm.bp(random_tiny(0, groups=False), time_limit=limit)
     assert seen["time_limit"] < limit
     assert seen["cut_rounds"] == default_cut_rounds(limit) == (6 if limit >= CUTS_FROM_S else 0)
+    assert seen["cut_gap"] == default_cut_gap(limit) == (1.0 if limit >= OPEN_CUTS_FROM_S else 0.5)
 
 
 def test_cuts_are_on_by_default_for_long_runs_only():
@@ -833,6 +838,18 @@ def test_cuts_are_on_by_default_for_long_runs_only():
     assert BranchAndPrice(inst, time_limit=None).cut_rounds > 0
     assert BranchAndPrice(inst, time_limit=None, cut_rounds=0).cut_rounds == 0
     assert BranchAndPrice(inst, time_limit=10, cut_rounds=2).cut_rounds == 2
+
+
+def test_cut_gate_opens_for_long_runs():
+    """Below OPEN_CUTS_FROM_S a cut round needs the root LP within half a step of a useful drop;
+    from it (and without a limit) the gate is open; an explicit cut_gap wins."""
+    from formulations.bp.branch_price import OPEN_CUTS_FROM_S, BranchAndPrice
+
+    inst = random_tiny(0, groups=False)
+    assert BranchAndPrice(inst, time_limit=OPEN_CUTS_FROM_S - 1).cut_gap == 0.5
+    assert BranchAndPrice(inst, time_limit=OPEN_CUTS_FROM_S).cut_gap == 1.0
+    assert BranchAndPrice(inst, time_limit=None).cut_gap == 1.0
+    assert BranchAndPrice(inst, time_limit=None, cut_gap=0.25).cut_gap == 0.25
 
 
 def _arcs_of_plans_from(inst: TOPInstance, value: float) -> set:
