@@ -110,6 +110,17 @@ seeds 0..7, 60 s through the registry, one thread):
   pool finds the optimum (57, 53) that PyVRP (56, 52, with any of 6 seeds), the dives and 60 s
   of branching had missed. K = 6 (seeds 0..4): bounds 89, 96, 98, 100, 89 as before, since the
   root converges only at 40-55 s.
+- 2026-12-02 (later), between K = 3 and K = 6 (M = 20, N = 5, two processes side by side): at
+  60 s nothing is proven on K = 4 (80 viewpoints; seeds 0, 1: bound/plan 68/66, 71/69) or K = 5
+  (100 viewpoints; 78/76, 83/82). At 300 s with the open cut gate (:func:`default_cut_gap`) K = 4
+  seed 0 is proven (68, 118 s; 64 cuts, the plan of 68 came after the cuts); K = 4 seed 1 stays
+  at 70/69, K = 5 seed 1 at 83/82, K = 6 seed 0 at 88/86. K = 3 seed 5 at 300 s: proven in
+  76-80 s (labelling before the cuts; 145 s before). Cut rounds during 60 % instead of 35 % of
+  300 s on K = 6 (seeds 0, 1): root LP 89.05 -> 88.60 with 64 cuts, bounds unchanged (88, 95),
+  so the share stays 35 %.
+- Dual smoothing (Wentges, the exact pricing at 0.5 x the best certified duals + 0.5 x the LP's,
+  mispricing -> the LP's duals) was tried and dropped: the same 31 exact pricings on K = 6 seed 0
+  (6 of them mispriced), and K = 3 seed 5 went from proven at 60 s to open.
 
 Subset-row cuts are off below ``CUTS_FROM_S`` (60 s): on a 30-viewpoint instance they once
 turned a 2 s proof into 22 s. Before arc elimination the threshold was 120 s (at 60 s, side by
