@@ -451,11 +451,12 @@ def run_local(jobs: list[dict], emit, *, workers: int, memory_mb: int = 0) -> No
                     w.kill()
 
 
-def _warm_up(methods, stream) -> None:
+def warm_up_methods(methods, stream) -> None:
     """Compile the numba code of the suite's methods in the parent, before the workers fork:
     they inherit it, so no job pays for it (the first bp job on a fresh checkout used to spend
     ~26 s of its time limit compiling, enough for the harness to kill a 60 s job). numba keeps
-    the compiled code on disk, so later runs load it in well under a second."""
+    the compiled code on disk, so later runs load it in a few seconds. ``stream``: where to say
+    so (None: silently)."""
     hooks = {get_method(m).warm_up for m in methods} - {None}
     if not hooks:
         return
@@ -495,7 +496,7 @@ def connect(address: str):
 
 def run_dask(jobs: list[dict], emit, *, scheduler, warm=()) -> None:
     """Run ``jobs`` on a Dask cluster (an address like ``tcp://host:8786`` or a Client). The
-    methods in ``warm`` compile their numba code on every worker first (see :func:`_warm_up`)."""
+    methods in ``warm`` compile their numba code on every worker first (see :func:`warm_up_methods`)."""
     if not jobs:
         return
     from dask.distributed import Client, as_completed
@@ -572,7 +573,7 @@ def _run_suite(suite, out_dir, workers, resume, scheduler, address, progress, st
         if scheduler:
             run_dask(payload, emit, scheduler=scheduler, warm=methods)
         else:
-            _warm_up(methods, stream if progress else None)
+            warm_up_methods(methods, stream if progress else None)
             run_local(payload, emit, workers=workers, memory_mb=suite.memory_mb)
         wall = time.monotonic() - t0
         with (store.directory / "runs.jsonl").open("a") as fh:

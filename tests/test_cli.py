@@ -40,6 +40,8 @@ def test_solve_json_stdout_is_one_object_for_exact_methods(tmp_path, method):
     assert out.returncode == 0, out.stderr
     rec = json.loads(out.stdout)
     assert rec["method"] == method and rec["status"] == "optimal" and rec["valid"] is True
+    # bp's numba code is compiled (or loaded) first, and the user is told so on stderr
+    assert ("compiling numba code" in out.stderr) == (method == "bp")
 
 
 def test_solve_top_file_summary():
