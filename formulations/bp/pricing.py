@@ -705,6 +705,8 @@ def _label_table(cost, profit, budget, ng, allowed, threshold, max_labels, deadl
     units = np.minimum((en / delta + 1e-9).astype(np.int64), nb)
     np.maximum.at(table, (node, units), pr)
     routes, sets = [], set()
+    if n_routes <= 0:  # the backward search: only its table is wanted
+        return np.maximum.accumulate(table, axis=1), routes
     done = (node > 0) & (en + cost[node, end] <= budget) & (pr > threshold)
     cand = np.flatnonzero(done)
     for li in cand[np.argsort(-pr[cand], kind="stable")]:
