@@ -8,7 +8,7 @@ import math
 import sys
 from pathlib import Path
 
-from formulations.errors import SarcoverError
+from sarcover.formulations.errors import SarcoverError
 
 
 class CLIError(SarcoverError):
@@ -46,7 +46,7 @@ def _int_at_least(minimum: int):
 
 # -- generate -----------------------------------------------------------------------------------
 def _add_generate(sub):
-    from formulations.generate import PRESETS
+    from sarcover.formulations.generate import PRESETS
 
     p = sub.add_parser("generate", help="draw a random SAR instance (targets uniform in 2000 m × 2000 m)")
     p.add_argument("--targets", "-M", type=_int_at_least(1), required=True, help="number of targets M")
@@ -64,8 +64,8 @@ def _add_generate(sub):
 
 
 def _cmd_generate(args) -> int:
-    from formulations.generate import generate
-    from formulations.io import save_json
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.io import save_json
 
     sar = generate(
         args.targets, args.views, args.uavs, args.seed, args.preset,
@@ -87,7 +87,7 @@ def _add_methods(sub):
 
 
 def _cmd_methods(args) -> int:
-    from benchmarks.registry import METHODS
+    from sarcover.benchmarks.registry import METHODS
 
     width = max(len(n) for n in METHODS)
     for spec in METHODS.values():
@@ -109,15 +109,15 @@ def _add_solve(sub):
 
 
 def _cmd_solve(args) -> int:
-    from benchmarks.registry import get_method, result_record, run_method
-    from formulations.io import load_instance
+    from sarcover.benchmarks.registry import get_method, result_record, run_method
+    from sarcover.formulations.io import load_instance
 
     spec = get_method(args.method)
     if args.plot and not Path(args.plot).parent.exists():
         raise CLIError(f"--plot: directory {Path(args.plot).parent} does not exist")
     instance = load_instance(args.file)
     if spec.warm_up is not None:  # a pause of ~30 s on a fresh checkout deserves a word
-        from benchmarks.harness import warm_up_methods
+        from sarcover.benchmarks.harness import warm_up_methods
 
         warm_up_methods([spec.name], sys.stderr)
     result, report = run_method(spec.name, instance, seed=args.seed, time_limit=args.time_limit)
@@ -134,7 +134,7 @@ def _cmd_solve(args) -> int:
 def _write_plot(instance, result, record, path):
     import matplotlib.pyplot as plt
 
-    from reports.plots import plot_plan
+    from sarcover.reports.plots import plot_plan
 
     cov = f"{100 * record['coverage']:.1f}%" if record["coverage"] is not None else "no plan"
     fig, ax = plt.subplots(figsize=(7, 7))
@@ -168,7 +168,7 @@ def _summary(instance, spec, rec) -> str:
 # -- bench / report -------------------------------------------------------------------------------
 def _add_bench(sub):
     p = sub.add_parser("bench", help="run a benchmark suite (built-in name or TOML file) into a results directory")
-    from benchmarks.suite import builtin_suites
+    from sarcover.benchmarks.suite import builtin_suites
 
     p.add_argument("suite", nargs="?", default="quick", help=f"built-in suite ({', '.join(builtin_suites())}) "
                    "or a suite TOML file (default quick)")
@@ -190,8 +190,8 @@ def _method_list(text: str) -> list[str]:
 
 
 def _cmd_bench(args) -> int:
-    from benchmarks.harness import run_suite
-    from benchmarks.suite import load_suite
+    from sarcover.benchmarks.harness import run_suite
+    from sarcover.benchmarks.suite import load_suite
 
     suite = load_suite(args.suite, runs=args.runs, methods=args.methods)
     out = Path(args.output) if args.output else Path("results") / suite.name
@@ -211,7 +211,7 @@ def _add_report(sub):
 
 
 def _cmd_report(args) -> int:
-    from reports.report import write_report
+    from sarcover.reports.report import write_report
 
     out = Path(args.output) if args.output else Path(args.results) / "report"
     summary = write_report(args.results, out)

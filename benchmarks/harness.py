@@ -1,6 +1,6 @@
 """Run a suite's jobs in isolated worker processes (or on a Dask cluster) into the results store.
 
-- :func:`run_one` runs one job (build the instance, :func:`benchmarks.registry.run_method`, which
+- :func:`run_one` runs one job (build the instance, :func:`sarcover.benchmarks.registry.run_method`, which
   verifies the plan) and returns its results row. It never raises.
 - Local execution keeps ``workers`` long-lived processes, each running one job at a time (short
   jobs are sent in batches, see :func:`_next_batch`, each still with its own deadline and row). The
@@ -14,7 +14,7 @@
   deadline is recorded as ``time_limit`` and its thread is abandoned; a worker that dies is
   retried by Dask and then recorded as ``error``.
 - Rows are appended to ``RESULTS_DIR/results.jsonl`` by the parent as each job finishes (see
-  :mod:`reports.results` for the format).
+  :mod:`sarcover.reports.results` for the format).
 """
 
 from __future__ import annotations
@@ -35,10 +35,10 @@ from collections import deque
 from multiprocessing.connection import wait
 from pathlib import Path
 
-from formulations.errors import SarcoverError
-from reports.results import RESULTS_FILE, SCHEMA_VERSION, read_rows
-from benchmarks.registry import get_method, warm_up
-from benchmarks.suite import Suite
+from sarcover.formulations.errors import SarcoverError
+from sarcover.reports.results import RESULTS_FILE, SCHEMA_VERSION, read_rows
+from sarcover.benchmarks.registry import get_method, warm_up
+from sarcover.benchmarks.suite import Suite
 
 _PACKAGES = ("sarcover", "numpy", "scipy", "pandas", "scikit-learn", "pyomo", "highspy", "ortools",
              "pyvrp", "numba", "dask", "distributed")
@@ -84,12 +84,12 @@ def cached_instance(source: dict):
 def build_instance(source: dict):
     """The TOPInstance a job's ``source`` describes (generator parameters or a file)."""
     if source["type"] == "generate":
-        from formulations.generate import generate
-        from formulations.instance import to_top
+        from sarcover.formulations.generate import generate
+        from sarcover.formulations.instance import to_top
 
         return to_top(generate(source["M"], source["K"], source["N"], source["instance_seed"],
                                source["preset"], **source["overrides"]))
-    from formulations.io import load_instance
+    from sarcover.formulations.io import load_instance
 
     return load_instance(source["path"])
 
@@ -122,7 +122,7 @@ def run_one(job: dict) -> dict:
     t0, c0 = time.perf_counter(), time.thread_time()
     row = base_row(job)
     try:
-        from benchmarks.registry import result_record, run_method
+        from sarcover.benchmarks.registry import result_record, run_method
 
         instance = cached_instance(job["source"])
         row.update(kind=instance.kind, n_nodes=instance.n_nodes, n_groups=len(instance.groups),

@@ -18,10 +18,10 @@ import traceback
 from dataclasses import dataclass
 from typing import Callable
 
-from formulations.errors import SarcoverError
-from formulations.instance import TOPInstance, precheck
-from formulations.plan import Result, Status
-from formulations.verify import VerificationReport, verify
+from sarcover.formulations.errors import SarcoverError
+from sarcover.formulations.instance import TOPInstance, precheck
+from sarcover.formulations.plan import Result, Status
+from sarcover.formulations.verify import VerificationReport, verify
 
 
 @dataclass(frozen=True)
@@ -43,37 +43,37 @@ def _resolve(target: str) -> Callable:
     return getattr(importlib.import_module(module), func)
 
 
-_ROUTERS_JIT = "heuristics.pipeline:warm_up"  # the PSO, GA and ACO kernels
+_ROUTERS_JIT = "sarcover.heuristics.pipeline:warm_up"  # the PSO, GA and ACO kernels
 
 _SPECS = [
-    MethodSpec("greedy", "heuristics.greedy:greedy", False,
+    MethodSpec("greedy", "sarcover.heuristics.greedy:greedy", False,
                "cheapest insertion by prize per energy, groups first (floor baseline)"),
-    MethodSpec("adpc-pso", "heuristics.pipeline:adpc_pso", False,
+    MethodSpec("adpc-pso", "sarcover.heuristics.pipeline:adpc_pso", False,
                "the paper's: ADPC clusters, random-key PSO tours (+2-opt), energy repair and refill",
                _ROUTERS_JIT),
-    MethodSpec("dpc-pso", "heuristics.pipeline:dpc_pso", False,
+    MethodSpec("dpc-pso", "sarcover.heuristics.pipeline:dpc_pso", False,
                "DPC clusters, random-key PSO tours (+2-opt), energy repair and refill", _ROUTERS_JIT),
-    MethodSpec("kmeans-pso", "heuristics.pipeline:kmeans_pso", False,
+    MethodSpec("kmeans-pso", "sarcover.heuristics.pipeline:kmeans_pso", False,
                "scikit-learn KMeans clusters, random-key PSO tours (+2-opt), energy repair and refill",
                _ROUTERS_JIT),
-    MethodSpec("adpc-ga", "heuristics.pipeline:adpc_ga", False,
+    MethodSpec("adpc-ga", "sarcover.heuristics.pipeline:adpc_ga", False,
                "ADPC clusters, GA tours (OX, inversion, elitism; +2-opt), energy repair and refill",
                _ROUTERS_JIT),
-    MethodSpec("adpc-aco", "heuristics.pipeline:adpc_aco", False,
+    MethodSpec("adpc-aco", "sarcover.heuristics.pipeline:adpc_aco", False,
                "ADPC clusters, elitist ant system tours (+2-opt), energy repair and refill",
                _ROUTERS_JIT),
-    MethodSpec("cpsat", "heuristics.cpsat_warm:cpsat", True,
+    MethodSpec("cpsat", "sarcover.heuristics.cpsat_warm:cpsat", True,
                "CP-SAT routes constraint + energy flow, greedy hint, 1 thread; optimal only if proven unscaled"),
-    MethodSpec("routing", "heuristics.routing_method:routing", False,
+    MethodSpec("routing", "sarcover.heuristics.routing_method:routing", False,
                "OR-Tools routing, prize disjunctions + energy dimension, guided local search, <=10 s"),
-    MethodSpec("pyvrp", "heuristics.pyvrp_method:pyvrp", False,
+    MethodSpec("pyvrp", "sarcover.heuristics.pyvrp_method:pyvrp", False,
                "PyVRP iterated local search, optional clients with prizes, max distance = energy, 2000 its"),
-    MethodSpec("milp", "heuristics.milp_warm:milp", True,
+    MethodSpec("milp", "sarcover.heuristics.milp_warm:milp", True,
                "time-flow TOP MILP on HiGHS via Pyomo: pruned arcs, cliques, path + connectivity cuts, 1 thread, gap 0"),
-    MethodSpec("bp", "heuristics.bp_warm:bp", True,
+    MethodSpec("bp", "sarcover.heuristics.bp_warm:bp", True,
                "branch-and-price: route master on HiGHS, ng-route labelling pricing (numba), greedy's routes "
                "as first columns, PyVRP as primal heuristic once the root leaves the proof open, 1 thread",
-               "formulations.bp.pricing:warm_up"),
+               "sarcover.formulations.bp.pricing:warm_up"),
 ]
 
 METHODS: dict[str, MethodSpec] = {spec.name: spec for spec in _SPECS}

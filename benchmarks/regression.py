@@ -1,6 +1,6 @@
 """Regression table of proven optimal values, confirmed by both exact solvers (`milp`, `cpsat`).
 
-``python -m benchmarks.regression [--time-limit S] [--random N]`` re-solves every instance of the
+``python -m sarcover.benchmarks.regression [--time-limit S] [--random N]`` re-solves every instance of the
 table with both methods and rewrites ``benchmarks/regression/optimal_values.csv``; a row is kept
 only if both proved optimality and agree (or both proved infeasibility). Instances are either
 generated (``gen:M,K,N,seed,e_max`` with the paper preset) or TOP benchmark files (``top:p2.2.k``).
@@ -16,9 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from formulations.generate import generate
-from formulations.instance import TOPInstance, to_top
-from formulations.io import read_top
+from sarcover.formulations.generate import generate
+from sarcover.formulations.instance import TOPInstance, to_top
+from sarcover.formulations.io import read_top
 
 ROOT = Path(__file__).resolve().parent
 TABLE = ROOT / "regression" / "optimal_values.csv"
@@ -71,7 +71,7 @@ def read_table(path: Path = TABLE) -> list[dict]:
 
 def confirm(spec: str, time_limit: float) -> dict | None:
     """Solve with both exact methods; the row if both proved the same thing, else None."""
-    from benchmarks.registry import run_method  # the CLI side; formulations never import this
+    from sarcover.benchmarks.registry import run_method  # the CLI side; formulations never import this
 
     inst = load_spec(spec)
     out = {}
@@ -102,7 +102,7 @@ def regenerate(time_limit: float = 60.0, n_random: int = 40, path: Path = TABLE)
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m benchmarks.regression", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m sarcover.benchmarks.regression", description=__doc__.splitlines()[0])
     ap.add_argument("--time-limit", type=float, default=60.0, help="seconds per solver and instance")
     ap.add_argument("--random", type=int, default=40, help="number of generated SAR instances")
     ap.add_argument("--out", type=Path, default=TABLE)

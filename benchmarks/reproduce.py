@@ -1,8 +1,8 @@
-"""Reproduce the paper and write the reference report: ``python -m benchmarks.reproduce``.
+"""Reproduce the paper and write the reference report: ``python -m sarcover.benchmarks.reproduce``.
 
 Runs the built-in suites into ``RESULTS/<suite>`` (default ``results/reference``), resuming whatever
 is already stored there, then writes ``reports/reference/README.md`` with its PNGs and CSVs
-(:func:`reports.reference.write_reference`):
+(:func:`sarcover.reports.reference.write_reference`):
 
 ================  ===================================================================================
 paper-n           Fig. 3: M=20, K=3, N=2..6; the five paper methods + greedy, ``--runs`` per setting
@@ -34,7 +34,7 @@ EXACT_ONLY = {"top-chao": ["milp", "cpsat", "bp"]}  # suites run with only these
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m benchmarks.reproduce", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m sarcover.benchmarks.reproduce", description=__doc__.splitlines()[0])
     ap.add_argument("--results", default="results/reference", help="results root (default results/reference)")
     ap.add_argument("--out", default="reports/reference", help="report directory (default reports/reference)")
     ap.add_argument("--runs", type=int, default=1000, help="instances per setting of paper-n/paper-k (default 1000)")
@@ -45,9 +45,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--note", action="append", default=[], help="a paragraph to add to the report (repeatable)")
     args = ap.parse_args(argv)
 
-    from benchmarks.harness import run_suite
-    from benchmarks.suite import load_suite
-    from reports.reference import write_reference
+    from sarcover.benchmarks.harness import run_suite
+    from sarcover.benchmarks.suite import load_suite
+    from sarcover.reports.reference import write_reference
 
     root = Path(args.results)
     if not args.report_only:
@@ -63,7 +63,7 @@ def main(argv: list[str] | None = None) -> int:
                   f"{summary['counts']}", file=sys.stderr)
     notes = ([f"paper-n and paper-k ran with {args.runs} random instances per setting."] if not args.report_only
              else []) + args.note
-    path = write_reference(root, args.out, command=f"python -m benchmarks.reproduce --runs {args.runs}", notes=notes)
+    path = write_reference(root, args.out, command=f"python -m sarcover.benchmarks.reproduce --runs {args.runs}", notes=notes)
     print(f"wrote {path}", file=sys.stderr)
     return 0
 

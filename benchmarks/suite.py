@@ -51,7 +51,7 @@ import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from formulations.errors import SarcoverError
+from sarcover.formulations.errors import SarcoverError
 
 SUITES_DIR = Path(__file__).resolve().parent / "suites"
 TOP_DIR = Path(__file__).resolve().parent / "instances" / "top"
@@ -220,7 +220,7 @@ def check_method(name: str, where: str) -> bool:
 
     Returns whether the method is exact.
     """
-    from benchmarks.registry import METHODS
+    from sarcover.benchmarks.registry import METHODS
 
     if name in METHODS:
         return METHODS[name].exact
@@ -237,8 +237,8 @@ def check_method(name: str, where: str) -> bool:
 
 
 def _generated_sources(spec: dict, where: str, runs_override: int | None):
-    from formulations.errors import InstanceError
-    from formulations.generate import PRESETS, generate
+    from sarcover.formulations.errors import InstanceError
+    from sarcover.formulations.generate import PRESETS, generate
 
     unknown = set(spec) - _GEN_KEYS - set(_GEN_OVERRIDES)
     if unknown:

@@ -45,7 +45,7 @@ value reaches that bound, otherwise FEASIBLE with the relaxed bound. So scaling 
 Prizes must be integers or decimals with at most 6 digits; they are scaled by the smallest power
 of ten that makes them integral (exact), anything else raises :class:`CpsatInputError`.
 
-Anytime history (``info["history"]``, see :mod:`formulations.history`): ``[t, incumbent, bound]``
+Anytime history (``info["history"]``, see :mod:`sarcover.formulations.history`): ``[t, incumbent, bound]``
 points in prize units (scaled objective / prize scale), t from the call of :func:`solve_cpsat`.
 Incumbents: every solution CP-SAT reports (a solution callback) is read back into routes and
 verified; only truly feasible plans count, so every incumbent is at most the optimum (and the
@@ -69,11 +69,11 @@ import time
 import numpy as np
 from ortools.sat.python import cp_model
 
-from formulations.errors import SarcoverError
-from formulations.history import History
-from formulations.instance import TOPInstance, precheck
-from formulations.plan import Plan, Result, Status
-from formulations.verify import REL_TOL, verify
+from sarcover.formulations.errors import SarcoverError
+from sarcover.formulations.history import History
+from sarcover.formulations.instance import TOPInstance, precheck
+from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.verify import REL_TOL, verify
 
 TARGET_SCALED_BUDGET = 1e7
 MAX_PRIZE_DECIMALS = 6

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from formulations.errors import InstanceError
-from formulations.instance import SARInstance
+from sarcover.formulations.errors import InstanceError
+from sarcover.formulations.instance import SARInstance
 
 AREA = 2000.0  # metres; targets uniform in [0, AREA]^2, base at the corner (0, 0)
 

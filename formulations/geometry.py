@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from formulations.errors import InstanceError
+from sarcover.formulations.errors import InstanceError
 
 
 def standoff(altitude: float, pitch_deg: float) -> float:

@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from formulations.errors import InstanceError
-from formulations.geometry import viewpoints
+from sarcover.formulations.errors import InstanceError
+from sarcover.formulations.geometry import viewpoints
 
 
 def _finite(name: str, value: float, *, positive: bool = False, nonnegative: bool = False) -> float:

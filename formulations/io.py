@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from formulations.errors import InstanceError
-from formulations.instance import SARInstance, TOPInstance, to_top
+from sarcover.formulations.errors import InstanceError
+from sarcover.formulations.instance import SARInstance, TOPInstance, to_top
 
 FORMAT = "sarcover-instance"
 FORMAT_VERSION = 1

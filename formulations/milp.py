@@ -5,7 +5,7 @@ TOP literature (Bianchessi, Mansini & Speranza 2018), aggregated over vehicles, 
 vehicle symmetry at all:
 
 - ``x[i, j]`` binary: some vehicle travels arc (i, j); only arcs that a route within the budget
-  can use exist (:func:`formulations.preprocess.prune_arcs`).
+  can use exist (:func:`sarcover.formulations.preprocess.prune_arcs`).
 - ``y[i]`` binary: node i is visited; ``sum(x[start, j]) <= N`` vehicles leave the start.
 - ``z[i, j] >= 0``: the energy a vehicle has used when it arrives at j over (i, j). Flow
   conservation at a node adds the cost of the arc leaving it; the lifted bounds
@@ -18,7 +18,7 @@ Valid inequalities added up front (they are what makes the root bound usable, se
 
 - 2-cycles ``x_ij + x_ji <= y_i, y_j``;
 - incompatibility cliques: nodes no two of which fit on one route (by the triangle inequality,
-  :func:`formulations.preprocess.incompatible_cliques`): ``sum_K y <= vehicles used``;
+  :func:`sarcover.formulations.preprocess.incompatible_cliques`): ``sum_K y <= vehicles used``;
 - infeasible 2-arc paths: ``x_ik + sum_j x_kj <= y_k`` over the j that cannot follow i -> k.
 
 Flow strictly increases along an arc of positive cost, so subtours can appear only among
@@ -39,7 +39,7 @@ the verifier accepts is cut off (the bound is valid). A plan HiGHS returns that 
 rejects (possible only within HiGHS's feasibility tolerance) is never reported: its route is cut
 off by a no-good cut, which removes only that infeasible route, and the model is re-solved.
 
-Anytime history (``info["history"]``, see :mod:`formulations.history`): ``[t, incumbent, bound]``
+Anytime history (``info["history"]``, see :mod:`sarcover.formulations.history`): ``[t, incumbent, bound]``
 points in prize units, t from the call of :func:`solve_milp`. Incumbents are verified plans only:
 the warm start, and every improving MIP solution HiGHS reports (``cbMipImprovingSolution``, read
 back into routes; a solution with subtours counts with its routes from the depot only, and only
@@ -66,10 +66,10 @@ from pyomo.contrib.solver.common.results import TerminationCondition
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import maximum_flow
 
-from formulations.history import History
-from formulations.instance import TOPInstance, precheck
-from formulations.plan import Plan, Result, Status
-from formulations.preprocess import (
+from sarcover.formulations.history import History
+from sarcover.formulations.instance import TOPInstance, precheck
+from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.preprocess import (
     ArcGraph,
     floor_to_lattice,
     incompatibility,
@@ -77,7 +77,7 @@ from formulations.preprocess import (
     prize_lattice,
     prune_arcs,
 )
-from formulations.verify import verify
+from sarcover.formulations.verify import verify
 
 METHOD = "milp"
 _CUT_TOL = 1e-4  # a connectivity cut is added when violated by more than this
@@ -92,7 +92,7 @@ def build_milp(
     ``graph`` is the pruned arc set (computed if omitted). ``two_cycle`` adds
     x_ij + x_ji <= y_i for node pairs, which removes 2-node subtours and tightens the LP.
     ``cliques`` adds sum_{i in K} y_i <= (vehicles used) for sets K of pairwise incompatible
-    nodes (:func:`formulations.preprocess.incompatible_cliques`): a route visits at most one.
+    nodes (:func:`sarcover.formulations.preprocess.incompatible_cliques`): a route visits at most one.
     Components: sets ``N`` (node solver indices), ``A`` (arcs); variables ``x``, ``y``, ``z``;
     ``cuts`` is an empty ConstraintList for the cuts added while solving.
     """
@@ -410,7 +410,7 @@ def solve_milp(
     """Solve ``instance`` exactly with HiGHS (see the module docstring for the method).
 
     ``warm_start``: a valid plan handed to HiGHS as its first incumbent (formulations cannot import
-    heuristics; the registered ``milp`` method in :mod:`heuristics.exact` passes greedy's plan).
+    heuristics; the registered ``milp`` method in :mod:`sarcover.heuristics.exact` passes greedy's plan).
     ``root_rounds``: rounds of LP connectivity-cut separation before the MIP (0 turns it off).
     Returns OPTIMAL only when the verified plan reaches HiGHS's proven bound.
     """

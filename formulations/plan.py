@@ -46,7 +46,7 @@ class Plan:
 class Result:
     """What a method returns. ``bound`` is a proven upper bound on the objective, or None.
 
-    ``objective`` and the verdict fields are filled in by :func:`benchmarks.registry.run_method`
+    ``objective`` and the verdict fields are filled in by :func:`sarcover.benchmarks.registry.run_method`
     from the independent verifier, never trusted from the method itself.
     """
 

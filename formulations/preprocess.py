@@ -3,7 +3,7 @@
 Everything here is in SOLVER ORDER (index 0 = start, 1..V = nodes, V+1 = end, as
 :meth:`TOPInstance.cost_matrix`). The pruning is safe for the verifier's tolerance: an arc is
 dropped only if every route using it costs more than ``budget_with_tolerance(instance)``, the
-largest route energy :func:`formulations.verify.verify` accepts. The argument is the triangle
+largest route energy :func:`sarcover.formulations.verify.verify` accepts. The argument is the triangle
 inequality: with Euclidean distances and a non-negative per-node cost, the cheapest way from the
 start to node i is the direct arc (c_0i), and from j to the end is c_j,end, so any route using
 arc (i, j) costs at least c_0i + c_ij + c_j,end.
@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from formulations.instance import TOPInstance
-from formulations.verify import REL_TOL
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.verify import REL_TOL
 
 # Float noise between the cost matrix (numpy) and the verifier (math.hypot) is ~1e-15 relative;
 # pruning keeps this much extra slack so that it can never drop an arc of an accepted route.

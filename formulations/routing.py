@@ -1,6 +1,6 @@
 """The OR-Tools routing solver on the TOP form (a heuristic: no bound).
 
-The registered method `routing` (:mod:`heuristics.routing_method`) calls :func:`solve_routing`,
+The registered method `routing` (:mod:`sarcover.heuristics.routing_method`) calls :func:`solve_routing`,
 falling back to a greedy warm start when the cold search leaves a group uncovered.
 
 Model (the sequence of the OR-Tools samples: build, set limits and strategy, solve, extract):
@@ -8,7 +8,7 @@ Model (the sequence of the OR-Tools samples: build, set limits and strategy, sol
 - locations: 0 = start, 1..k = the k useful nodes (reachable alone within the budget, and with a
   prize or in a group), k+1 = end; one vehicle per UAV with ``starts=[0]*N``, ``ends=[k+1]*N``,
   so distinct start and end depots need nothing special.
-- an ``energy`` dimension with the integer arc energies of :mod:`formulations.scaling`
+- an ``energy`` dimension with the integer arc energies of :mod:`sarcover.formulations.scaling`
   (``ceil(scale*c_ij)``, capacity ``floor(scale*E_max)``): any plan the solver accepts is within
   the true budget. The start → end arc is 0 (an empty route costs nothing).
 - one disjunction per node, penalty = its prize scaled so that the smallest prize outweighs any
@@ -37,10 +37,10 @@ import time
 import numpy as np
 from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 
-from formulations.instance import TOPInstance
-from formulations.plan import Plan, Result, Status
-from formulations.scaling import integer_prizes, scaled_costs
-from formulations.verify import verify
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.scaling import integer_prizes, scaled_costs
+from sarcover.formulations.verify import verify
 
 DEFAULT_TIME_CAP = 10.0  # seconds, when no time limit is given
 SOLUTION_LIMIT = 1000  # local-search solutions; the reproducible stop (~1-10 s at 60 nodes)

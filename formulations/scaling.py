@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from formulations.instance import TOPInstance
+from sarcover.formulations.instance import TOPInstance
 
 DEFAULT_RESOLUTION = 10**6  # integer units per budget: arc rounding loses <= 1e-6 of E_max per arc
 

@@ -9,8 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from formulations.instance import TOPInstance
-from formulations.plan import Plan
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.plan import Plan
 
 REL_TOL = 1e-9
 

@@ -1,11 +1,11 @@
 """The registered `bp` method: branch-and-price warm-started by heuristics.
 
-``formulations`` may not import heuristics, so :func:`formulations.bp.solve_bp` takes optional
+``formulations`` may not import heuristics, so :func:`sarcover.formulations.bp.solve_bp` takes optional
 ``initial_routes`` and a ``primal`` callback; this glue hands it
 
 - greedy's plan (milliseconds) as the first columns and incumbent, so a run stopped early still
   returns a plan covering every target whenever greedy found one;
-- PyVRP's iterated local search (:mod:`heuristics.pyvrp_method`, the strongest heuristic of the
+- PyVRP's iterated local search (:mod:`sarcover.heuristics.pyvrp_method`, the strongest heuristic of the
   suite) as ``primal``: bp runs it once, with 10 % of its time limit (at most 10 s), only when
   the root's floored bound and the first dive leave the proof open (most TOP instances never
   pay for it). Its routes become columns and its plan, if better, the incumbent.
@@ -20,16 +20,16 @@ from __future__ import annotations
 
 import time
 
-from formulations.bp import default_cut_gap, default_cut_rounds, solve_bp
-from formulations.bp.pricing import warm_up
-from formulations.history import shifted
-from formulations.plan import Result, Status
-from heuristics.greedy import greedy
+from sarcover.formulations.bp import default_cut_gap, default_cut_rounds, solve_bp
+from sarcover.formulations.bp.pricing import warm_up
+from sarcover.formulations.history import shifted
+from sarcover.formulations.plan import Result, Status
+from sarcover.heuristics.greedy import greedy
 
 
 def _pyvrp_routes(instance, seed: int):
     """``primal`` callback: PyVRP's plan within the given seconds, as routes of node ids."""
-    from heuristics.pyvrp_method import pyvrp
+    from sarcover.heuristics.pyvrp_method import pyvrp
 
     def run(seconds: float):
         res = pyvrp(instance, seed=seed, time_limit=max(seconds, 0.05))

@@ -1,8 +1,8 @@
 """The registered `cpsat` method: CP-SAT warm-started with greedy's plan.
 
-:mod:`formulations.cpsat` cannot import heuristics (imports flow one way), so this wrapper runs
-:func:`heuristics.greedy.greedy` (milliseconds) and hands its plan to
-:func:`formulations.cpsat.solve_cpsat` as a CP-SAT hint. Measured: with one worker CP-SAT alone
+:mod:`sarcover.formulations.cpsat` cannot import heuristics (imports flow one way), so this wrapper runs
+:func:`sarcover.heuristics.greedy.greedy` (milliseconds) and hands its plan to
+:func:`sarcover.formulations.cpsat.solve_cpsat` as a CP-SAT hint. Measured: with one worker CP-SAT alone
 found no plan within 60 s on 6 of the 30-node TOP instances of set 1, and found one quickly with
 the hint. The hint changes neither the model nor the proof; only the search starts there.
 """
@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import time
 
-from formulations.cpsat import solve_cpsat
-from formulations.history import shifted
-from formulations.instance import TOPInstance
-from formulations.plan import Result, Status
-from heuristics.greedy import greedy
+from sarcover.formulations.cpsat import solve_cpsat
+from sarcover.formulations.history import shifted
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.plan import Result, Status
+from sarcover.heuristics.greedy import greedy
 
 THREADS = 1  # one CP-SAT worker: fair next to single-threaded heuristics and reproducible enough
 

@@ -1,6 +1,6 @@
 """`greedy`: the floor baseline. Cover every group by cheapest insertion, then insert by prize per energy.
 
-It is the energy repair's insertion phases (:class:`heuristics.repair.Repairer`) on empty routes:
+It is the energy repair's insertion phases (:class:`sarcover.heuristics.repair.Repairer`) on empty routes:
 
 1. groups: among the uncovered groups, the one whose cheapest feasible insertion is the most
    expensive goes first (hardest first), inserted at that cheapest place (first route, then
@@ -16,10 +16,10 @@ import time
 
 import numpy as np
 
-from formulations.instance import TOPInstance
-from formulations.plan import Plan, Result, Status
-from heuristics.insertion import RouteSet
-from heuristics.repair import Repairer
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.heuristics.insertion import RouteSet
+from sarcover.heuristics.repair import Repairer
 
 
 def greedy(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:

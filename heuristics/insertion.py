@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from formulations.instance import TOPInstance
+from sarcover.formulations.instance import TOPInstance
 
 
 class RouteSet:

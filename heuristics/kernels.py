@@ -157,7 +157,7 @@ if HAVE_NUMBA:
 
     @njit(cache=True, nogil=True)
     def best_two_opt_move(D, seq, n, start, end):  # pragma: no cover - compiled
-        """Best 2-opt move on start → seq[:n] → end, as :func:`heuristics.tour.best_two_opt_moves`
+        """Best 2-opt move on start → seq[:n] → end, as :func:`sarcover.heuristics.tour.best_two_opt_moves`
         scores it (same arithmetic, first maximum in the same pair order): (lo, hi, gain), with
         lo > hi and gain 0 when no move gains more than 1e-9."""
         best_g = -np.inf
@@ -185,7 +185,7 @@ if HAVE_NUMBA:
         """``n_iter`` whole PSO iterations in place, R[t, 0] and R[t, 1] the r1, r2 (B, P, L) of
         iteration t: the move, decoding, fitness, personal and swarm bests, then one best 2-opt
         move on each swarm's global best written back as keys; the steps and arithmetic of
-        :class:`heuristics.routing_pso.PSORouter`'s numpy loop (path lengths are summed in another
+        :class:`sarcover.heuristics.routing_pso.PSORouter`'s numpy loop (path lengths are summed in another
         order, so exact ties between a tour and its reverse may break the other way)."""
         B, P, L = x.shape
         order = np.empty(L, dtype=np.int64)
@@ -242,7 +242,7 @@ if HAVE_NUMBA:
     def aco_iterations(tau, log_eta, nodes, sizes, D, start, end, U, n_iter, first, alpha, rho,
                        elitist, best, best_f, polished, local_search):  # pragma: no cover - compiled
         """``n_iter`` colonies of the elitist ant system in place, as
-        :class:`heuristics.routing_aco.ACORouter`'s numpy loop does them on the same draws U[t]
+        :class:`sarcover.heuristics.routing_aco.ACORouter`'s numpy loop does them on the same draws U[t]
         (L, B, P) float32: wheel weights from τ^α·η^β (float32), tour construction
         (:func:`construct_tours`), lengths, the best tour so far and its 2-opt move, τ set to
         P / L₀ after the ``first`` colony, evaporation and the deposits of every ant and the
@@ -343,7 +343,7 @@ if HAVE_NUMBA:
     @njit(cache=True, nogil=True)
     def ga_generation(pop, f, t, ra, rb, rc, rd, re, rm, p_crossover, p_mutation, E,
                       D, nodes, sizes, start, end):  # pragma: no cover - compiled
-        """One GA generation from the draws of :class:`heuristics.routing_ga.GARouter`'s numpy loop
+        """One GA generation from the draws of :class:`sarcover.heuristics.routing_ga.GARouter`'s numpy loop
         (tournaments ``t`` (B, 2C, 2), cut, crossover and mutation uniforms (B*C,)): the E best
         kept (stable order), parents by binary tournament, OX + inversion (:func:`ga_children`),
         children's lengths. Returns the new population and lengths."""

@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import time
 
-from formulations.history import shifted
-from formulations.milp import solve_milp
-from formulations.plan import Result, Status
-from heuristics.greedy import greedy
+from sarcover.formulations.history import shifted
+from sarcover.formulations.milp import solve_milp
+from sarcover.formulations.plan import Result, Status
+from sarcover.heuristics.greedy import greedy
 
 
 def milp(instance, *, seed: int = 0, time_limit: float | None = 60.0, threads: int = 1) -> Result:

@@ -5,7 +5,7 @@
    there are fewer viewpoints).
 2. Route each group start → group → end with a metaheuristic (PSO, GA or ACO; population 30,
    100 iterations), all groups in one numpy batch; fitness = flight distance. Then 2-opt.
-3. Energy repair (:mod:`heuristics.repair`): drop viewpoints from over-budget tours, cover every
+3. Energy repair (:mod:`sarcover.heuristics.repair`): drop viewpoints from over-budget tours, cover every
    target, refill with removed viewpoints that fit.
 
 Runs are seeded (``numpy.random.default_rng(seed)``; KMeans gets ``random_state=seed``) and
@@ -21,14 +21,14 @@ from typing import Callable
 
 import numpy as np
 
-from formulations.instance import TOPInstance
-from formulations.plan import Plan, Result, Status
-from heuristics.clustering import ADPC, DPC
-from heuristics.repair import RepairFailed, Repairer
-from heuristics.routing_aco import ACORouter
-from heuristics.routing_ga import GARouter
-from heuristics.routing_pso import PSORouter
-from heuristics.tour import ClusterBatch, two_opt
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.heuristics.clustering import ADPC, DPC
+from sarcover.heuristics.repair import RepairFailed, Repairer
+from sarcover.heuristics.routing_aco import ACORouter
+from sarcover.heuristics.routing_ga import GARouter
+from sarcover.heuristics.routing_pso import PSORouter
+from sarcover.heuristics.tour import ClusterBatch, two_opt
 
 
 def make_clusterer(kind: str, n_clusters: int, instance: TOPInstance, seed: int):
@@ -153,10 +153,10 @@ def adpc_aco(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
 def warm_up() -> None:
     """Compile (or load from numba's disk cache) the routers' kernels: one PSO, GA and ACO run on
     a small instance (about 5 s the first time on a checkout, well under 1 s from the cache).
-    The benchmark harness calls it before its workers start (:func:`benchmarks.registry.warm_up`),
+    The benchmark harness calls it before its workers start (:func:`sarcover.benchmarks.registry.warm_up`),
     so the compilation is not charged to a method's first job."""
-    from formulations.generate import generate
-    from formulations.instance import to_top
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
 
     instance = to_top(generate(4, 3, 2, seed=0))
     for router in ("pso", "ga", "aco"):

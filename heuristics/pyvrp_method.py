@@ -7,7 +7,7 @@ Model (PyVRP's ``Model`` builder):
   when it differs, an end depot; one vehicle type with ``num_available = N``,
   ``start_depot``/``end_depot``, ``max_distance = floor(S * E_max)``.
 - energy folded into integer arc lengths, ``distance(i, j) = ceil(S * c_ij)`` with
-  c_ij = e_fly·d_ij + e_image·[j is a node] (:mod:`formulations.scaling`; S puts E_max at
+  c_ij = e_fly·d_ij + e_image·[j is a node] (:mod:`sarcover.formulations.scaling`; S puts E_max at
   ``RESOLUTION`` units). Rounding arcs up and the budget down means every route PyVRP calls
   feasible is within the true budget (PyVRP would truncate floats, so we round ourselves).
 - PyVRP minimises distance cost minus collected prizes. Prizes are scaled so that the smallest
@@ -41,10 +41,10 @@ import numpy as np
 from pyvrp import Model, Solution
 from pyvrp.stop import MaxIterations, MaxRuntime, MultipleCriteria
 
-from formulations.instance import TOPInstance
-from formulations.plan import Plan, Result, Status
-from formulations.scaling import integer_prizes, scaled_costs
-from heuristics.insertion import RouteSet
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.scaling import integer_prizes, scaled_costs
+from sarcover.heuristics.insertion import RouteSet
 
 RESOLUTION = 10**5  # integer distance units per E_max (rounding loses <= 1e-5 E_max per arc)
 ITERATIONS = 2000  # ILS iterations, the reproducible stop

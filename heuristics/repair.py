@@ -26,9 +26,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from formulations.instance import TOPInstance
-from heuristics.insertion import RouteSet
-from heuristics.tour import route_length, two_opt
+from sarcover.formulations.instance import TOPInstance
+from sarcover.heuristics.insertion import RouteSet
+from sarcover.heuristics.tour import route_length, two_opt
 
 
 class RepairFailed(Exception):

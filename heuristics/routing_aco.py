@@ -14,7 +14,7 @@ Vectorised over ants and clusters at once: the colony is (B, P) ants, a step dra
 next viewpoint by a roulette wheel (a cumulative sum over the candidates and one uniform draw per
 ant), and deposits use one ``np.bincount``; the only Python loop is over the L construction
 steps. With numba (default when importable) whole colonies run compiled
-(:func:`heuristics.kernels.aco_iterations`), 20 at a time between deadline checks, on uniforms
+(:func:`sarcover.heuristics.kernels.aco_iterations`), 20 at a time between deadline checks, on uniforms
 drawn by numpy in the same stream: the same tours as the numpy loop but for exact length ties
 (a tour and its reverse when start = end), which the two paths' sums may break differently.
 """
@@ -25,11 +25,11 @@ import time
 
 import numpy as np
 
-from heuristics.kernels import HAVE_NUMBA
-from heuristics.tour import ClusterBatch, best_two_opt_moves, invert
+from sarcover.heuristics.kernels import HAVE_NUMBA
+from sarcover.heuristics.tour import ClusterBatch, best_two_opt_moves, invert
 
 if HAVE_NUMBA:
-    from heuristics.kernels import aco_iterations
+    from sarcover.heuristics.kernels import aco_iterations
 
 _PAD = -1e300
 # Weight of a pad: absorbed in the wheel's total (≥ 1e-20 while real viewpoints remain, since

@@ -11,7 +11,7 @@ Like the PSO, all clusters run in one (B, P, L) batch: a row's pads sit in the t
 every individual and stay there (cuts and inversions are drawn inside the real positions), so
 no per-individual Python loop is needed; OX is done for the whole batch with two scatters.
 With numba (default when importable) a whole generation (elitism, tournaments, OX, inversion,
-fitness) runs in the compiled :func:`heuristics.kernels.ga_generation` on the same draws as the
+fitness) runs in the compiled :func:`sarcover.heuristics.kernels.ga_generation` on the same draws as the
 numpy generation; only the draws stay in Python (the same children, but for ties between
 lengths summed in another order).
 """
@@ -22,11 +22,11 @@ import time
 
 import numpy as np
 
-from heuristics.kernels import HAVE_NUMBA
-from heuristics.tour import ClusterBatch, invert
+from sarcover.heuristics.kernels import HAVE_NUMBA
+from sarcover.heuristics.tour import ClusterBatch, invert
 
 if HAVE_NUMBA:
-    from heuristics.kernels import ga_generation
+    from sarcover.heuristics.kernels import ga_generation
 
 
 def order_crossover(p1: np.ndarray, p2: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""`routing`: OR-Tools routing with guided local search (:mod:`formulations.routing`).
+"""`routing`: OR-Tools routing with guided local search (:mod:`sarcover.formulations.routing`).
 
 The cold search (local cheapest insertion, then guided local search) gets ``COLD_SHARE`` of the
 time. If its best plan leaves a group uncovered, or collects less than the `greedy` plan (which
@@ -14,10 +14,10 @@ from __future__ import annotations
 
 import time
 
-from formulations.instance import TOPInstance
-from formulations.plan import Result, Status
-from formulations.routing import DEFAULT_TIME_CAP, solve_routing
-from heuristics.greedy import greedy
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.plan import Result, Status
+from sarcover.formulations.routing import DEFAULT_TIME_CAP, solve_routing
+from sarcover.heuristics.greedy import greedy
 
 TIME_CAP = 10.0  # seconds: the method runs at most min(time_limit, TIME_CAP)
 COLD_SHARE = 0.6

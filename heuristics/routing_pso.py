@@ -18,7 +18,7 @@ swarm's global best and writes the improved order back as keys (a memetic PSO: t
 then attracted to a 2-opt-improved leader). This costs one (B, L²/2) array per iteration.
 
 With numba (default when importable) whole iterations run compiled
-(:func:`heuristics.kernels.pso_iterations`: move, decoding, fitness, bests and the 2-opt move),
+(:func:`sarcover.heuristics.kernels.pso_iterations`: move, decoding, fitness, bests and the 2-opt move),
 20 at a time between deadline checks, on r1, r2 drawn by numpy in the same stream as the numpy
 loop (``use_numba=False``). Both paths give the same tours on the same seed except where a tour
 and its reverse tie exactly in length (their sums run in another order); drawing the random
@@ -31,11 +31,11 @@ import time
 
 import numpy as np
 
-from heuristics.kernels import HAVE_NUMBA
-from heuristics.tour import ClusterBatch, best_two_opt_moves, invert
+from sarcover.heuristics.kernels import HAVE_NUMBA
+from sarcover.heuristics.tour import ClusterBatch, best_two_opt_moves, invert
 
 if HAVE_NUMBA:
-    from heuristics.kernels import keyed_lengths, pso_iterations
+    from sarcover.heuristics.kernels import keyed_lengths, pso_iterations
 
 
 _PAD_KEY = 1e6
@@ -76,7 +76,7 @@ class PSORouter:
         v = np.where(pad, 0.0, rng.uniform(-self.v_max, self.v_max, (B, P, L)))
         rows = np.arange(B)
 
-        if self.use_numba:  # decode + lengths in one compiled call (heuristics.kernels)
+        if self.use_numba:  # decode + lengths in one compiled call (sarcover.heuristics.kernels)
             nodes, sizes = np.ascontiguousarray(batch.nodes), np.ascontiguousarray(batch.sizes)
             Dc = np.ascontiguousarray(D, dtype=float)
 
@@ -123,7 +123,7 @@ class PSORouter:
         return best, gbest_f
 
     def _move(self, x, v, pbest, pbest_f, gbest, r1, r2, evaluate):
-        """One PSO move, fitness and personal bests in numpy (:func:`heuristics.kernels.pso_iterations` compiled)."""
+        """One PSO move, fitness and personal bests in numpy (:func:`sarcover.heuristics.kernels.pso_iterations` compiled)."""
         v = self.w * v + self.c1 * r1 * (pbest - x) + self.c2 * r2 * (gbest[:, None, :] - x)
         np.clip(v, -self.v_max, self.v_max, out=v)
         x = x + v

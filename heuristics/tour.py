@@ -1,6 +1,6 @@
 """Shared tour helpers: batched path lengths, padded batches of clusters, and 2-opt.
 
-All indices here are SOLVER indices of a :class:`~formulations.instance.TOPInstance` distance
+All indices here are SOLVER indices of a :class:`~sarcover.formulations.instance.TOPInstance` distance
 or cost matrix: 0 = start, 1..V = nodes, V+1 = end. A tour is the path start → nodes → end.
 
 The routers solve several clusters at once. :class:`ClusterBatch` stacks the clusters into one

@@ -1,4 +1,4 @@
-"""Optimality gaps from a results table (one row per job; see :mod:`reports.results`).
+"""Optimality gaps from a results table (one row per job; see :mod:`sarcover.reports.results`).
 
 Gap of a run with objective ``obj`` on an instance with proven optimum ``opt``::
 

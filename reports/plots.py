@@ -8,8 +8,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from formulations.instance import TOPInstance  # noqa: E402
-from formulations.plan import Plan  # noqa: E402
+from sarcover.formulations.instance import TOPInstance  # noqa: E402
+from sarcover.formulations.plan import Plan  # noqa: E402
 
 
 def plot_plan(instance: TOPInstance, plan: Plan | None, ax=None, title: str | None = None):
@@ -50,7 +50,7 @@ def plot_anytime(series: dict, ax=None, title: str | None = None, reference: flo
     """Bound and incumbent against time, one colour per method.
 
     ``series`` maps a method name to its history ``[[t, incumbent, bound], ...]`` (see
-    :mod:`formulations.history`; None where a value is not known yet). The incumbent is a solid
+    :mod:`sarcover.formulations.history`; None where a value is not known yet). The incumbent is a solid
     step line, the bound a dashed one, each drawn from its first known value and ending in a
     marker; ``reference`` (a proven or published optimum) is a thin grey dotted line; ``colors``
     (method -> colour) keeps colours fixed across panels; ``legend=False`` leaves the legend to

@@ -1,7 +1,7 @@
 """The reference report of issue 7: the paper's experiment reproduced, claim by claim, with gaps.
 
 ``write_reference(results_root, out_dir)`` reads the result directories that
-``python -m benchmarks.reproduce`` fills (one per suite: paper-n, paper-k, paper-peers, exact-small,
+``python -m sarcover.benchmarks.reproduce`` fills (one per suite: paper-n, paper-k, paper-peers, exact-small,
 paper-gaps, paper-gaps-long, emax-sweep, table1, top-chao; any may be missing) and writes ``out_dir/README.md`` with PNG figures and CSV
 tables beside it. Every number in the text is computed here from the stored rows.
 
@@ -22,8 +22,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from benchmarks.reproduce import SUITES  # noqa: E402  (the suites this report renders, run order)
-from reports.results import load_results  # noqa: E402
+from sarcover.benchmarks.reproduce import SUITES  # noqa: E402  (the suites this report renders, run order)
+from sarcover.reports.results import load_results  # noqa: E402
 
 PAPER = ["adpc-pso", "dpc-pso", "kmeans-pso", "adpc-ga", "adpc-aco"]
 PEERS = ["pyvrp", "routing", "greedy"]
@@ -111,7 +111,7 @@ def _paired_best(df: pd.DataFrame, x: str) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def write_reference(root: str | Path, out: str | Path, *, command: str = "python -m benchmarks.reproduce",
+def write_reference(root: str | Path, out: str | Path, *, command: str = "python -m sarcover.benchmarks.reproduce",
                     notes: list[str] | None = None) -> Path:
     root, out = Path(root), Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -124,7 +124,7 @@ def write_reference(root: str | Path, out: str | Path, *, command: str = "python
     timing = t1 if t1 is not None else pk  # Table I from the one-worker timing suite when there
     L: list[str] = ["# Reference report: the paper reproduced, with optimality gaps", ""]
     L += [f"Regenerate everything (runs, then this report) with `{command}`; "
-          "`python -m benchmarks.reproduce --report-only` rewrites the report from stored results. "
+          "`python -m sarcover.benchmarks.reproduce --report-only` rewrites the report from stored results. "
           "All numbers below are computed from the stored rows (CSV tables beside this file).", ""]
     L += ["Coverage = covered viewpoints / (M·K). A run without a plan (the method cannot cover every target "
           "within E_max) counts as coverage 0; the share of runs with a plan is in the CSVs.", ""]
@@ -327,7 +327,7 @@ def _projection(timing: pd.DataFrame) -> str:
 
 
 def _preset_section() -> list[str]:
-    from formulations.generate import PRESETS
+    from sarcover.formulations.generate import PRESETS
 
     p = PRESETS["paper"]
     stand = p["altitude"] * np.cos(np.radians(p["pitch_deg"]))
@@ -380,7 +380,7 @@ def _table1(pk: pd.DataFrame, out: Path) -> pd.DataFrame | None:
 
 
 def _gaps_section(ex, pg, out: Path) -> list[str]:
-    from reports.gaps import add_gaps, instance_table, method_table
+    from sarcover.reports.gaps import add_gaps, instance_table, method_table
 
     L = ["## Optimality gaps (what the paper could not show)", ""]
     if ex is not None:
@@ -522,10 +522,10 @@ def _bp_run_summary(bp: pd.DataFrame) -> str:
 
 
 def _routes(pk: pd.DataFrame, peers: pd.DataFrame | None, out: Path) -> list[str]:
-    from formulations.generate import generate
-    from formulations.instance import to_top
-    from formulations.plan import Plan
-    from reports.plots import plot_plan
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
+    from sarcover.formulations.plan import Plan
+    from sarcover.reports.plots import plot_plan
 
     pick = "sar-m20-k3-n5-s0"
     rows = pd.concat([pk] + ([peers] if peers is not None else []), ignore_index=True)

@@ -20,8 +20,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from reports.gaps import add_gaps, instance_table, method_table  # noqa: E402
-from reports.results import load_results  # noqa: E402
+from sarcover.reports.gaps import add_gaps, instance_table, method_table  # noqa: E402
+from sarcover.reports.results import load_results  # noqa: E402
 
 _PCT = ("gap_mean", "gap_median", "gap_max", "share_optimal", "gap_ub_mean", "gap_ub_median",
         "gap_ub_max", "coverage_mean")
@@ -163,12 +163,12 @@ def _runtime_table(sar: pd.DataFrame, out: Path, doc: _Doc):
 
 
 def _example_routes(df: pd.DataFrame, out: Path, doc: _Doc):
-    from formulations.generate import generate
-    from formulations.instance import to_top
-    from formulations.io import load_instance
-    from formulations.plan import Plan
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
+    from sarcover.formulations.io import load_instance
+    from sarcover.formulations.plan import Plan
 
-    from reports.plots import plot_plan
+    from sarcover.reports.plots import plot_plan
 
     ok = df[df["valid"].astype(bool) & df["routes"].notna()]
     if ok.empty:
@@ -277,7 +277,7 @@ def _anytime_series(row) -> list | None:
 
 def _anytime(df: pd.DataFrame, inst: pd.DataFrame, out: Path, doc: _Doc):
     """Bound and incumbent against time of the exact methods, one panel per instance."""
-    from reports.plots import anytime_legend, plot_anytime
+    from sarcover.reports.plots import anytime_legend, plot_anytime
 
     ex = df[df["exact"].astype(bool) & (df["status"] != "error")] if "exact" in df else df.iloc[:0]
     series: dict = {}

@@ -30,7 +30,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from formulations.errors import SarcoverError
+from sarcover.formulations.errors import SarcoverError
 
 SCHEMA_VERSION = 1
 RESULTS_FILE = "results.jsonl"

@@ -3,7 +3,7 @@
 import os
 import time
 
-from formulations.plan import Plan, Result, Status
+from sarcover.formulations.plan import Plan, Result, Status
 
 
 def crash(instance, *, seed=0, time_limit=None):

@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from formulations.instance import TOPInstance
+from sarcover.formulations.instance import TOPInstance
 
 ROOT = Path(__file__).resolve().parents[1]
 TOP_DIR = ROOT / "benchmarks" / "instances" / "top"

@@ -9,15 +9,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmarks.harness import run_suite
-from benchmarks.registry import run_method
-from benchmarks.suite import load_suite
-from formulations.history import History, thin
-from formulations.instance import TOPInstance
-from formulations.io import read_top
-from formulations.plan import Status
-from reports.report import write_report
-from reports.results import SCHEMA_VERSION
+from sarcover.benchmarks.harness import run_suite
+from sarcover.benchmarks.registry import run_method
+from sarcover.benchmarks.suite import load_suite
+from sarcover.formulations.history import History, thin
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.io import read_top
+from sarcover.formulations.plan import Status
+from sarcover.reports.report import write_report
+from sarcover.reports.results import SCHEMA_VERSION
 
 TOP_DIR = Path(__file__).resolve().parents[1] / "benchmarks" / "instances" / "top"
 PUBLISHED = {r["instance"]: (float(r["value"]), r["status"]) for r in csv.DictReader(open(TOP_DIR / "optimal.csv"))}

@@ -11,10 +11,10 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from benchmarks.cli import main
-from benchmarks.harness import run_suite
-from benchmarks.suite import load_suite
-from reports.results import read_rows
+from sarcover.benchmarks.cli import main
+from sarcover.benchmarks.harness import run_suite
+from sarcover.benchmarks.suite import load_suite
+from sarcover.reports.results import read_rows
 
 TESTS = Path(__file__).resolve().parent
 ROOT = TESTS.parent
@@ -143,7 +143,7 @@ e_max = 20000  # one UAV can fly all four viewpoints
 """)
     out = tmp_path / "res"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
-    proc = subprocess.Popen([sys.executable, "-m", "benchmarks.cli", "bench", str(suite), "-o", str(out),
+    proc = subprocess.Popen([sys.executable, "-m", "sarcover.benchmarks.cli", "bench", str(suite), "-o", str(out),
                              "--workers", "2", "--quiet"], env=env, start_new_session=True,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     results = out / "results.jsonl"
@@ -257,7 +257,7 @@ seed = 10
 
 def test_builtin_suites_load_with_registered_methods():
     """Every built-in suite parses, names only registered methods, and paper-n is M=20, K=3, N=2..6."""
-    from benchmarks.suite import builtin_suites
+    from sarcover.benchmarks.suite import builtin_suites
 
     assert {"quick", "exact-small", "paper-n", "paper-k", "top-chao"} <= set(builtin_suites())
     for name in builtin_suites():
@@ -273,7 +273,7 @@ def test_progress_bar_counts_and_eta():
     """The progress bar prints count, percentage and an ETA; errors and time limits are tallied."""
     import io
 
-    from benchmarks.harness import Progress
+    from sarcover.benchmarks.harness import Progress
 
     stream = io.StringIO()
     bar = Progress(4, "bench t", stream=stream)
@@ -285,10 +285,10 @@ def test_progress_bar_counts_and_eta():
 
 def test_ad_hoc_methods_do_not_join_the_registry(tmp_path):
     """A suite's ``module:function`` method runs, but never shows up in the shared registry."""
-    from benchmarks.registry import METHODS, get_method, run_method
-    from formulations.generate import generate
-    from formulations.instance import to_top
-    from formulations.plan import Status
+    from sarcover.benchmarks.registry import METHODS, get_method, run_method
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
+    from sarcover.formulations.plan import Status
 
     before = set(METHODS)
     inst = to_top(generate(2, 2, 1, 0))
@@ -328,11 +328,11 @@ def test_ctrl_c_in_a_worker_stops_the_run_without_storing_its_job(tmp_path, caps
 WARM_CHECK = r"""
 import json, sys
 from numba.core.registry import CPUDispatcher
-import formulations.bp.pricing as pricing
-import heuristics.kernels as kernels
-from benchmarks.registry import METHODS, run_method, warm_up
-from formulations.generate import generate
-from formulations.instance import to_top
+import sarcover.formulations.bp.pricing as pricing
+import sarcover.heuristics.kernels as kernels
+from sarcover.benchmarks.registry import METHODS, run_method, warm_up
+from sarcover.formulations.generate import generate
+from sarcover.formulations.instance import to_top
 
 def compiled():
     out = {}
@@ -361,22 +361,22 @@ def test_warm_up_leaves_nothing_for_the_jobs_to_compile():
     out = subprocess.run([sys.executable, "-c", WARM_CHECK], cwd=ROOT, capture_output=True,
                          text=True, timeout=600, check=True)
     data = json.loads(out.stdout.strip().splitlines()[-1])
-    assert sorted(data["hooks"]) == ["formulations.bp.pricing:warm_up", "heuristics.pipeline:warm_up"]
+    assert sorted(data["hooks"]) == ["sarcover.formulations.bp.pricing:warm_up", "sarcover.heuristics.pipeline:warm_up"]
     assert sum(data["before"].values()) == 0  # a fresh process: nothing compiled yet
-    assert data["warmed"]["formulations.bp.pricing._label"] > 0
-    assert data["warmed"]["heuristics.kernels.pso_iterations"] > 0
+    assert data["warmed"]["sarcover.formulations.bp.pricing._label"] > 0
+    assert data["warmed"]["sarcover.heuristics.kernels.pso_iterations"] > 0
     assert data["after"] == data["warmed"]
     assert set(data["statuses"].values()) <= {"optimal", "feasible"}
 
 
 def test_warm_up_runs_each_hook_once_and_skips_a_broken_one(monkeypatch):
-    import benchmarks.registry as registry
+    import sarcover.benchmarks.registry as registry
 
     calls = []
     monkeypatch.setattr(registry, "_WARMED", set())
     monkeypatch.setattr(registry, "_resolve", lambda target: (lambda: calls.append(target)))
     assert registry.warm_up(["adpc-pso", "dpc-pso", "greedy", "bp", "tests.x:y"]) == [
-        "heuristics.pipeline:warm_up", "formulations.bp.pricing:warm_up"]
+        "sarcover.heuristics.pipeline:warm_up", "sarcover.formulations.bp.pricing:warm_up"]
     assert registry.warm_up(["adpc-ga", "bp"]) == []  # already done in this process
     assert len(calls) == 2
 
@@ -410,9 +410,9 @@ def test_own_folder_of_instance_files_gives_share_proven_and_certified_gaps(tmp_
     size and bounds the gap of the runs it did not prove by their certified bound."""
     import shutil
 
-    from benchmarks.suite import TOP_DIR
-    from formulations.generate import generate
-    from formulations.io import save_json
+    from sarcover.benchmarks.suite import TOP_DIR
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.io import save_json
 
     folder = tmp_path / "Set_own"
     folder.mkdir()

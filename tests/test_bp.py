@@ -11,12 +11,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmarks.registry import run_method
-from formulations.bp import solve_bp
-from formulations.instance import TOPInstance
-from formulations.io import load_instance
-from formulations.plan import Status
-from formulations.verify import route_energy, verify
+from sarcover.benchmarks.registry import run_method
+from sarcover.formulations.bp import solve_bp
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.io import load_instance
+from sarcover.formulations.plan import Status
+from sarcover.formulations.verify import route_energy, verify
 
 TOP_DIR = Path(__file__).resolve().parent.parent / "benchmarks" / "instances" / "top"
 OPTIMAL = {r["instance"]: float(r["value"]) for r in csv.DictReader(open(TOP_DIR / "optimal.csv"))}
@@ -153,7 +153,7 @@ def test_top_sets_1_to_3_all(name):
 
 def tiny_sar(e_max: float) -> TOPInstance:
     """Three targets, two views each, one UAV (explicit parameters: independent of the presets)."""
-    from formulations.instance import SARInstance, to_top
+    from sarcover.formulations.instance import SARInstance, to_top
 
     targets = np.array([[1500.0, 200.0], [200.0, 1500.0], [900.0, 900.0]])
     return to_top(SARInstance(targets=targets, n_views=2, n_uavs=1, altitude=200.0, pitch_deg=45.0,
@@ -172,7 +172,7 @@ def test_small_sar_matches_brute_force(e_max):
 
 def test_sar_infeasible_when_targets_do_not_fit():
     """Every target reachable alone but not all in one flight: proven infeasible (precheck passes)."""
-    from formulations.instance import precheck
+    from sarcover.formulations.instance import precheck
 
     inst = tiny_sar(4500.0)
     assert precheck(inst) is None and brute_force(inst) is None
@@ -184,7 +184,7 @@ def test_sar_infeasible_when_targets_do_not_fit():
 
 def _tiny_pricing(seed: int, n_nodes: int = 7):
     """A random pricing problem: Euclidean arcs with an image cost, reduced prizes of both signs."""
-    from formulations.bp.pricing import cheapest_return
+    from sarcover.formulations.bp.pricing import cheapest_return
 
     rng = np.random.default_rng(seed)
     inst = TOPInstance(coords=rng.uniform(0, 10, size=(n_nodes, 2)), prizes=np.ones(n_nodes),
@@ -214,7 +214,7 @@ def test_exact_pricing_matches_enumeration(seed, bidirectional):
     """Elementary labelling (heap order, buckets, reach-filtered completion bound): its best value
     is the best elementary path's prize, its routes are real improving paths; ng-8 labelling and the
     heuristic bracket it (ng value >= elementary best >= any heuristic route)."""
-    from formulations.bp.pricing import full_ng, nearest_ng, price
+    from sarcover.formulations.bp.pricing import full_ng, nearest_ng, price
 
     cost, ret, profit, budget = _tiny_pricing(seed)
     paths = _brute_paths(cost, profit, budget)
@@ -239,7 +239,7 @@ def test_exact_pricing_matches_enumeration(seed, bidirectional):
 @pytest.mark.parametrize("seed", range(4))
 def test_completion_bound_covers_every_suffix(seed):
     """_completion never undercuts the best elementary suffix of a path prefix (enumerated)."""
-    from formulations.bp.pricing import _completion, _prepare, n_words
+    from sarcover.formulations.bp.pricing import _completion, _prepare, n_words
 
     cost, ret, profit, budget = _tiny_pricing(seed)
     n = cost.shape[0]
@@ -275,7 +275,7 @@ def _branch_like(cost: np.ndarray, seed: int) -> None:
 def test_suffix_tables_cover_every_suffix(seed):
     """The DP suffix bound never undercuts the best elementary suffix of a path prefix
     (enumerated), also on a graph with forbidden arcs and no triangle inequality."""
-    from formulations.bp.pricing import _dp_bound, suffix_tables
+    from sarcover.formulations.bp.pricing import _dp_bound, suffix_tables
 
     cost, ret, profit, budget = _tiny_pricing(seed)
     if seed >= 2:
@@ -302,7 +302,7 @@ def test_arc_bounds_cover_every_path_through_an_arc(seed):
     """The arc bound (best prefix + arc + best suffix) is never below the prize of an elementary
     path through that arc (enumerated), also with forbidden arcs and no triangle inequality; and
     it is not vacuous: on these graphs it is finite and below the largest bound somewhere."""
-    from formulations.bp.pricing import arc_bounds
+    from sarcover.formulations.bp.pricing import arc_bounds
 
     cost, ret, profit, budget = _tiny_pricing(seed)
     n = cost.shape[0]
@@ -326,7 +326,7 @@ def test_label_arc_bounds_cover_every_path_above_the_threshold(seed, ng_size):
     """The labelling arc bound (ng-labels forward and backward, fixed threshold) is never below
     the prize of an elementary path through the arc whose prize beats the threshold; with
     elementary labels it is tighter than the DP arc bound on some arc."""
-    from formulations.bp.pricing import arc_bounds, label_arc_bounds, nearest_ng
+    from sarcover.formulations.bp.pricing import arc_bounds, label_arc_bounds, nearest_ng
 
     cost, ret, profit, budget = _tiny_pricing(seed)
     n = cost.shape[0]
@@ -361,7 +361,7 @@ def test_label_arc_bounds_cover_every_path_above_the_threshold(seed, ng_size):
 def test_suffix_tables_are_the_best_walk_without_turning_back():
     """On integer arc costs with a one-unit grid the tables are exact: the best walk (points may
     repeat, no immediate return) within b units, enumerated."""
-    from formulations.bp.pricing import _suffix_dp
+    from sarcover.formulations.bp.pricing import _suffix_dp
 
     rng = np.random.default_rng(7)
     n = 6  # start, 4 nodes, end
@@ -391,9 +391,9 @@ def test_suffix_tables_are_the_best_walk_without_turning_back():
 def test_ng_route_columns_count_visits():
     """A repeated point counts twice in its node row (never integer-feasible); routes that stop
     being ng-routes when the ng sets grow are excluded from the master."""
-    from formulations.bp.master import Master
-    from formulations.bp.pricing import add_to_ng, nearest_ng
-    from formulations.bp.branch_price import NodeState
+    from sarcover.formulations.bp.master import Master
+    from sarcover.formulations.bp.pricing import add_to_ng, nearest_ng
+    from sarcover.formulations.bp.branch_price import NodeState
 
     m = Master(4, np.ones(4), [(0, 1)], 2)
     m.add_routes([(1, 2, 3, 1), (1, 2), (3, 4)])
@@ -413,8 +413,8 @@ def test_branching_decisions_exclude_exactly_the_conflicting_routes():
     """Master.incompatible against its definition, route by route (repeated visits included):
     a route is out iff it visits a forbidden point, uses a forbidden arc, or leaves the tail of a
     forced arc (not the start) or enters its head (not the end) by another arc."""
-    from formulations.bp.branch_price import NodeState
-    from formulations.bp.master import Master
+    from sarcover.formulations.bp.branch_price import NodeState
+    from sarcover.formulations.bp.master import Master
 
     rng = np.random.default_rng(3)
     V, end = 7, 8
@@ -454,7 +454,7 @@ def test_branching_decisions_exclude_exactly_the_conflicting_routes():
 def test_targeted_slack_keeps_the_floor(value, n):
     """The raised exact-pricing threshold: dual value + N * (slack + TOL) stays below the next
     integer (or incumbent + 1), so 'nothing found above the threshold' settles floor(bound)."""
-    from formulations.bp.branch_price import TOL, BranchAndPrice
+    from sarcover.formulations.bp.branch_price import TOL, BranchAndPrice
 
     inst = TOPInstance(coords=[[1, 0]], prizes=[1], start=[0, 0], end=[0, 0], budget=5.0, n_vehicles=n)
     bp = BranchAndPrice(inst, time_limit=10)
@@ -472,7 +472,7 @@ def test_dive_gives_a_verified_plan(seed):
     """The diving heuristic (root LP, then fixing routes) only returns plans the verifier accepts,
     never better than enumeration; on these tiny instances it finds the enumerated optimum
     whenever a plan exists."""
-    from formulations.bp.branch_price import BranchAndPrice, NodeState
+    from sarcover.formulations.bp.branch_price import BranchAndPrice, NodeState
 
     inst = random_tiny(seed, groups=True)
     best = brute_force(inst)
@@ -488,8 +488,8 @@ def test_dive_gives_a_verified_plan(seed):
 def test_registered_bp_starts_from_greedy():
     """The registered `bp` gets greedy's routes as first columns: stopped almost at once on a
     paper-size instance it still returns a verified plan at least as good as greedy's, under its bound."""
-    from formulations.generate import generate
-    from formulations.instance import to_top
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
 
     inst = to_top(generate(20, 3, 5, 11))
     g, _ = run_method("greedy", inst)
@@ -574,7 +574,7 @@ def test_milp_column_filter_keeps_every_better_plan(name):
     """The reduced-cost filter of the MILP's columns (duals that certified the root bound)
     never removes a better plan: with the incumbent set below the best plan over the generated
     routes, the filtered MILP finds a plan of that same value, from fewer routes."""
-    from formulations.bp.branch_price import BranchAndPrice, NodeState
+    from sarcover.formulations.bp.branch_price import BranchAndPrice, NodeState
 
     inst = _top(name)
     bp = BranchAndPrice(inst, time_limit=30)
@@ -599,7 +599,7 @@ def test_strong_branching_proves_the_same_optimum():
     """Strong branching (children estimated on the current columns) changes which candidate is
     branched on, never the result: p3.3.o is proven at its published optimum either way, only
     the strong run pays for estimates, and the master's bounds are the node's again after them."""
-    from formulations.bp.branch_price import BranchAndPrice, NodeState
+    from sarcover.formulations.bp.branch_price import BranchAndPrice, NodeState
 
     inst = _top("p3.3.o")
     results = {st: solve_bp(inst, time_limit=30, strong=st) for st in (1, 5)}
@@ -622,7 +622,7 @@ def test_milp_start_plan_is_a_floor():
     """The MILP takes a plan as its first solution: with only that plan's routes allowed it
     returns that plan, under any time limit it returns nothing worse, and a start that is not
     made of generated routes is ignored (p2.2.k)."""
-    from formulations.bp.branch_price import BranchAndPrice, NodeState
+    from sarcover.formulations.bp.branch_price import BranchAndPrice, NodeState
 
     inst = _top("p2.2.k")
     bp = BranchAndPrice(inst, time_limit=30)
@@ -645,7 +645,7 @@ def test_milp_start_plan_is_a_floor():
 def test_lm_coefficient_counts_pairs_and_forgets_outside_memory():
     """Pairs of visits to the triple; an unpaired visit is forgotten at a point outside the
     memory, so the coefficient never exceeds floor(visits / 2) (the full cut's)."""
-    from formulations.bp.master import _lm_coefficient
+    from sarcover.formulations.bp.master import _lm_coefficient
 
     S, full = (1, 2, 3), frozenset(range(10))
     assert _lm_coefficient((1, 5, 2), S, full) == 1
@@ -680,8 +680,8 @@ def test_exact_pricing_with_cuts_matches_enumeration(seed):
     """With subset-row cut duals, exact elementary labelling finds the best path's prize minus
     the duals of the cuts it pays (limited-memory coefficients, enumerated); every route it
     returns has the value it claims to beat; ng labelling stays an upper bound."""
-    from formulations.bp.master import _lm_coefficient
-    from formulations.bp.pricing import full_ng, nearest_ng, price
+    from sarcover.formulations.bp.master import _lm_coefficient
+    from sarcover.formulations.bp.pricing import full_ng, nearest_ng, price
 
     rng = np.random.default_rng(100 + seed)
     cost, ret, profit, budget = _tiny_pricing(seed)
@@ -713,7 +713,7 @@ def test_exact_pricing_with_cuts_matches_enumeration(seed):
 def test_master_cut_rows_hold_lm_coefficients():
     """Cut rows get the limited-memory coefficient of routes generated before and after the
     cut; separation finds a violated triple in a fractional LP and its memory keeps it violated."""
-    from formulations.bp.master import Master, _lm_coefficient
+    from sarcover.formulations.bp.master import Master, _lm_coefficient
 
     m = Master(6, np.ones(6), [], 3)
     m.add_routes([(1, 2), (2, 3), (1, 3)])  # each x = 1/2 violates the cut on {1, 2, 3}: 3/2 > 1
@@ -743,7 +743,7 @@ def test_master_cut_rows_hold_lm_coefficients():
 def test_purged_cuts_leave_the_lp_and_free_their_bits():
     """Purging drops exactly the cuts of zero dual: same LP value, the rows and bitsets of the
     kept cuts renumbered, and routes and cuts added afterwards get the right coefficients."""
-    from formulations.bp.master import Master, _lm_coefficient
+    from sarcover.formulations.bp.master import Master, _lm_coefficient
 
     m = Master(6, np.ones(6), [], 6)
     m.add_routes([(1, 2), (2, 3), (1, 3), (4,), (5,), (6,)])
@@ -807,11 +807,11 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, thre
     """The registered bp spends a moment on greedy before solve_bp; whether cuts are on, and how
     open their gate is, follow the user's time limit (at CUTS_FROM_S: on; at OPEN_CUTS_FROM_S:
     open), not the slightly smaller one left for solve_bp."""
-    import formulations.bp.branch_price as branch_price
-    import heuristics.bp_warm as warm
-    from formulations.bp.branch_price import (CUTS_FROM_S, OPEN_CUTS_FROM_S, default_cut_gap,
+    import sarcover.formulations.bp.branch_price as branch_price
+    import sarcover.heuristics.bp_warm as warm
+    from sarcover.formulations.bp.branch_price import (CUTS_FROM_S, OPEN_CUTS_FROM_S, default_cut_gap,
                                               default_cut_rounds)
-    from formulations.plan import Result
+    from sarcover.formulations.plan import Result
 
     limit = getattr(branch_price, threshold) + offset
     seen = {}
@@ -830,7 +830,7 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, thre
 def test_cuts_are_on_by_default_for_long_runs_only():
     """Cuts slow pricing down; by default they are used from CUTS_FROM_S seconds (and without a
     limit) and can be forced either way."""
-    from formulations.bp.branch_price import CUTS_FROM_S, BranchAndPrice
+    from sarcover.formulations.bp.branch_price import CUTS_FROM_S, BranchAndPrice
 
     inst = random_tiny(0, groups=False)
     assert BranchAndPrice(inst, time_limit=CUTS_FROM_S - 1).cut_rounds == 0
@@ -843,7 +843,7 @@ def test_cuts_are_on_by_default_for_long_runs_only():
 def test_cut_gate_opens_for_long_runs():
     """Below OPEN_CUTS_FROM_S a cut round needs the root LP within half a step of a useful drop;
     from it (and without a limit) the gate is open; an explicit cut_gap wins."""
-    from formulations.bp.branch_price import OPEN_CUTS_FROM_S, BranchAndPrice
+    from sarcover.formulations.bp.branch_price import OPEN_CUTS_FROM_S, BranchAndPrice
 
     inst = random_tiny(0, groups=False)
     assert BranchAndPrice(inst, time_limit=OPEN_CUTS_FROM_S - 1).cut_gap == 0.5
@@ -870,7 +870,7 @@ def _arcs_of_plans_from(inst: TOPInstance, value: float) -> set:
 def test_arc_elimination_keeps_every_better_plan(seed):
     """With the incumbent one step below the optimum, reduced-cost arc elimination after the
     root LP (DP and labelling bounds) removes arcs, but none of any optimal plan (enumerated)."""
-    from formulations.bp.branch_price import BranchAndPrice, NodeState
+    from sarcover.formulations.bp.branch_price import BranchAndPrice, NodeState
 
     inst = random_tiny(seed, groups=False)
     best = brute_force(inst)
@@ -887,7 +887,7 @@ def test_arc_elimination_keeps_every_better_plan(seed):
 def test_labelling_arc_bounds_run_before_the_first_cut_round():
     """With cuts on, the root's labelling arc elimination runs before any cut is separated, so
     the cut rounds price on the smaller graph; the published optimum is still proven."""
-    from formulations.bp.branch_price import BranchAndPrice
+    from sarcover.formulations.bp.branch_price import BranchAndPrice
 
     events = []
 
@@ -919,7 +919,7 @@ def test_root_out_of_time_right_after_the_route_pool_joined():
     the time runs out right then (no re-solve, no dive), the root's LP solution must still match
     the master's columns. It used not to (a ValueError at M = 20, K = 6 in loaded runs); now the
     run stops with a valid bound."""
-    from formulations.bp.branch_price import BranchAndPrice
+    from sarcover.formulations.bp.branch_price import BranchAndPrice
 
     class OutOfTime(BranchAndPrice):
         def _eliminate_arcs(self, labels=False):

@@ -6,13 +6,13 @@ import sys
 
 import pytest
 
-from benchmarks.cli import main
+from sarcover.benchmarks.cli import main
 from conftest import TOP_DIR
 
 
 def run(*args):
     """Run the real console entry point in a subprocess (no traceback may leak)."""
-    return subprocess.run([sys.executable, "-m", "benchmarks.cli", *args], capture_output=True, text=True)
+    return subprocess.run([sys.executable, "-m", "sarcover.benchmarks.cli", *args], capture_output=True, text=True)
 
 
 def test_generate_solve_json_and_plot(tmp_path):
@@ -89,7 +89,7 @@ def test_bad_input_one_line_exit_2(tmp_path, args, needle):
     (tmp_path / "n.json").write_text("{oops")
     (tmp_path / "b.json").write_text(inst.read_text().replace('"e_max"', '"e_maxx"'))
     args = [a.format(inst=inst, notjson=tmp_path / "n.json", badfield=tmp_path / "b.json") for a in args]
-    out = subprocess.run([sys.executable, "-m", "benchmarks.cli", *args], capture_output=True, text=True,
+    out = subprocess.run([sys.executable, "-m", "sarcover.benchmarks.cli", *args], capture_output=True, text=True,
                          cwd=tmp_path)
     assert out.returncode == 2
     lines = out.stderr.strip().splitlines()

@@ -7,13 +7,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmarks.registry import run_method
-from formulations.cpsat import CpsatInputError, prize_scale, solve_cpsat
-from formulations.instance import TOPInstance
-from formulations.io import read_top
-from formulations.plan import Plan, Status
-from formulations.verify import verify
-from heuristics.greedy import greedy
+from sarcover.benchmarks.registry import run_method
+from sarcover.formulations.cpsat import CpsatInputError, prize_scale, solve_cpsat
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.io import read_top
+from sarcover.formulations.plan import Plan, Status
+from sarcover.formulations.verify import verify
+from sarcover.heuristics.greedy import greedy
 
 TOP_DIR = Path(__file__).resolve().parents[1] / "benchmarks" / "instances" / "top"
 

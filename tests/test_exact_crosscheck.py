@@ -9,9 +9,9 @@ an instance proven infeasible.
 
 import pytest
 
-from benchmarks.regression import load_spec, random_cases
-from benchmarks.registry import METHODS, run_method
-from formulations.plan import Status
+from sarcover.benchmarks.regression import load_spec, random_cases
+from sarcover.benchmarks.registry import METHODS, run_method
+from sarcover.formulations.plan import Status
 
 EXACT = ("milp", "cpsat")
 TOL = 1e-9

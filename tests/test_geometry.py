@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from formulations.errors import InstanceError
-from formulations.geometry import standoff, viewpoints
-from formulations.instance import SARInstance, to_top
+from sarcover.formulations.errors import InstanceError
+from sarcover.formulations.geometry import standoff, viewpoints
+from sarcover.formulations.instance import SARInstance, to_top
 
 
 def test_four_views_of_target_on_x_axis():

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from benchmarks.registry import run_method
-from formulations.generate import generate
-from formulations.instance import to_top
-from formulations.plan import Status
+from sarcover.benchmarks.registry import run_method
+from sarcover.formulations.generate import generate
+from sarcover.formulations.instance import to_top
+from sarcover.formulations.plan import Status
 
 
 def test_greedy_takes_everything_when_budget_allows(line_instance):
@@ -36,7 +36,7 @@ def test_greedy_rules_by_hand():
 
     Nodes at x = 1, 2 (group 0) and x = 5 (group 1, its only view), one vehicle, budget 10:
     group 1 (cheapest insertion 10) before group 0 (2), then node 2 (prize 3) fits, node 1 too."""
-    from formulations.instance import TOPInstance
+    from sarcover.formulations.instance import TOPInstance
 
     inst = TOPInstance(coords=np.array([[1.0, 0.0], [2.0, 0.0], [5.0, 0.0]]), prizes=np.array([1.0, 3.0, 1.0]),
                        start=np.zeros(2), end=np.zeros(2), budget=10.0, n_vehicles=1, groups=[[0, 1], [2]])

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from formulations.generate import generate
-from formulations.instance import to_top
-from heuristics.clustering import ADPC, DPC, cutoff_distance, pairwise_distances
+from sarcover.formulations.generate import generate
+from sarcover.formulations.instance import to_top
+from sarcover.heuristics.clustering import ADPC, DPC, cutoff_distance, pairwise_distances
 
 CENTRES = np.array([[0.0, 0.0], [20.0, 0.0], [10.0, 30.0]])
 

@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.registry import METHODS, run_method
-from formulations.generate import generate
-from formulations.instance import TOPInstance, to_top
-from formulations.plan import Status
-from formulations.verify import verify
+from sarcover.benchmarks.registry import METHODS, run_method
+from sarcover.formulations.generate import generate
+from sarcover.formulations.instance import TOPInstance, to_top
+from sarcover.formulations.plan import Status
+from sarcover.formulations.verify import verify
 
 PIPELINES = ["adpc-pso", "dpc-pso", "kmeans-pso", "adpc-ga", "adpc-aco"]
 FAST = ["adpc-pso", "dpc-pso", "kmeans-pso", "adpc-ga"]  # adpc-aco is ~3x slower: fewer cases

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from heuristics.routing_aco import ACORouter
-from heuristics.routing_ga import GARouter, order_crossover
-from heuristics.routing_pso import PSORouter
-from heuristics.tour import ClusterBatch, invert, path_lengths, route_length, two_opt
+from sarcover.heuristics.routing_aco import ACORouter
+from sarcover.heuristics.routing_ga import GARouter, order_crossover
+from sarcover.heuristics.routing_pso import PSORouter
+from sarcover.heuristics.tour import ClusterBatch, invert, path_lengths, route_length, two_opt
 
 ROUTERS = {"pso": PSORouter, "ga": GARouter, "aco": ACORouter}
 

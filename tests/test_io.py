@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from conftest import TOP_DIR
-from formulations.errors import InstanceError
-from formulations.generate import generate
-from formulations.io import load_instance, load_sar, read_top, save_json, sar_to_dict
+from sarcover.formulations.errors import InstanceError
+from sarcover.formulations.generate import generate
+from sarcover.formulations.io import load_instance, load_sar, read_top, save_json, sar_to_dict
 
 
 def test_json_round_trip(tmp_path):

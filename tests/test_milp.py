@@ -10,13 +10,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmarks.registry import run_method
-from formulations.instance import TOPInstance
-from formulations.io import read_top
-from formulations.milp import build_milp, solve_milp
-from formulations.plan import Plan, Status
-from formulations.preprocess import floor_to_lattice, incompatible_cliques, prize_lattice, prune_arcs
-from formulations.verify import route_energy
+from sarcover.benchmarks.registry import run_method
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.io import read_top
+from sarcover.formulations.milp import build_milp, solve_milp
+from sarcover.formulations.plan import Plan, Status
+from sarcover.formulations.preprocess import floor_to_lattice, incompatible_cliques, prize_lattice, prune_arcs
+from sarcover.formulations.verify import route_energy
 
 TOP_DIR = Path(__file__).resolve().parents[1] / "benchmarks" / "instances" / "top"
 PUBLISHED = {r["instance"]: float(r["value"]) for r in csv.DictReader(open(TOP_DIR / "optimal.csv"))}

@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
-from benchmarks.registry import run_method
-from formulations.generate import generate
-from formulations.instance import TOPInstance, to_top
-from formulations.plan import Plan, Status
-from formulations.scaling import integer_prizes, scaled_costs
-from formulations.verify import route_energy, verify
-from heuristics.pyvrp_method import cover_groups
+from sarcover.benchmarks.registry import run_method
+from sarcover.formulations.generate import generate
+from sarcover.formulations.instance import TOPInstance, to_top
+from sarcover.formulations.plan import Plan, Status
+from sarcover.formulations.scaling import integer_prizes, scaled_costs
+from sarcover.formulations.verify import route_energy, verify
+from sarcover.heuristics.pyvrp_method import cover_groups
 
 
 @pytest.mark.parametrize("seed", [0, 7])

@@ -2,9 +2,9 @@
 
 import pytest
 
-from benchmarks.regression import TABLE, load_spec, read_table
-from benchmarks.registry import METHODS, run_method
-from formulations.plan import Status
+from sarcover.benchmarks.regression import TABLE, load_spec, read_table
+from sarcover.benchmarks.registry import METHODS, run_method
+from sarcover.formulations.plan import Status
 
 ROWS = read_table(TABLE)
 # Default run: the rows both solvers confirmed fastest (at most 1 s each when the table was made).

@@ -6,9 +6,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from reports.gaps import add_gaps, instance_table, method_table
-from reports.report import write_report
-from reports.results import SCHEMA_VERSION, ResultsError, load_results, read_rows
+from sarcover.reports.gaps import add_gaps, instance_table, method_table
+from sarcover.reports.report import write_report
+from sarcover.reports.results import SCHEMA_VERSION, ResultsError, load_results, read_rows
 
 
 def row(instance, method, status, objective, bound=None, exact=False, reference=None, **extra):

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from benchmarks.harness import run_suite
-from benchmarks.suite import load_suite
-from reports.reference import write_reference
+from sarcover.benchmarks.harness import run_suite
+from sarcover.benchmarks.suite import load_suite
+from sarcover.reports.reference import write_reference
 
 
 @pytest.fixture(scope="module")
@@ -43,7 +43,7 @@ def test_top_table_checks_against_published_optima():
     bounds below and plans above the published optimum are counted, never hidden."""
     import pandas as pd
 
-    from reports.reference import top_table
+    from sarcover.reports.reference import top_table
 
     rows = [  # instance, method, status, objective, bound, reference, runtime
         ("p1.2.a", "milp", "optimal", 10.0, 10.0, 10.0, 1.0),

@@ -7,11 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmarks.registry import run_method
-from formulations.generate import generate
-from formulations.instance import TOPInstance, to_top
-from formulations.io import load_instance
-from formulations.plan import Status
+from sarcover.benchmarks.registry import run_method
+from sarcover.formulations.generate import generate
+from sarcover.formulations.instance import TOPInstance, to_top
+from sarcover.formulations.io import load_instance
+from sarcover.formulations.plan import Status
 
 TOP_DIR = Path(__file__).resolve().parents[1] / "benchmarks" / "instances" / "top"
 PEERS = ["routing", "pyvrp"]
@@ -149,7 +149,7 @@ def test_top_never_beats_optimum(method, name):
 
 def test_routing_reproducible_when_stopped_by_solution_limit():
     """OR-Tools routing stopped by its solution limit (not time) returns the same plan twice."""
-    from formulations.routing import solve_routing
+    from sarcover.formulations.routing import solve_routing
 
     inst = load_instance(TOP_DIR / "p2.3.g.txt")
     a = solve_routing(inst, time_limit=30.0, solution_limit=200)
@@ -172,8 +172,8 @@ def test_top_all_files_never_beat_optimum(method):
 def test_never_below_its_greedy_start():
     """With little time on a large instance (120 viewpoints, 1 s) routing still returns at least
     greedy's plan: a cold search that ends below greedy is followed by a greedy-started one."""
-    from formulations.generate import generate
-    from formulations.instance import to_top
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
 
     inst = to_top(generate(20, 6, 5, 3))
     g, _ = run_method("greedy", inst)

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from formulations.instance import SARInstance, TOPInstance, to_top
-from formulations.plan import Plan
-from formulations.verify import route_energy, verify
+from sarcover.formulations.instance import SARInstance, TOPInstance, to_top
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.verify import route_energy, verify
 
 
 def test_valid_plan_objective_and_energy(line_instance):

@@ -139,12 +139,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from formulations.bp.master import MAX_CUTS, Master
-from formulations.bp.pricing import (add_to_ng, arc_bounds, cheapest_return, full_ng,
+from sarcover.formulations.bp.master import MAX_CUTS, Master
+from sarcover.formulations.bp.pricing import (add_to_ng, arc_bounds, cheapest_return, full_ng,
                                      label_arc_bounds, nearest_ng, price, warm_up)
-from formulations.instance import TOPInstance, precheck
-from formulations.plan import Plan, Result, Status
-from formulations.verify import verify
+from sarcover.formulations.instance import TOPInstance, precheck
+from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.verify import verify
 
 TOL = 1e-6
 CUTS_FROM_S = 60.0  # time limits from which subset-row cuts are on by default

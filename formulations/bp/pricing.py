@@ -874,7 +874,7 @@ _WARM = False
 def warm_up() -> None:
     """Compile (or load from numba's on-disk cache) the labelling routines once per process:
     about 26 s the first time on a checkout (2-core machine), 0.5 s from the cache. The
-    benchmark harness calls it before its workers start (:func:`benchmarks.registry.warm_up`)."""
+    benchmark harness calls it before its workers start (:func:`sarcover.benchmarks.registry.warm_up`)."""
     global _WARM
     if _WARM:
         return

@@ -1,6 +1,6 @@
 """Speed of the harness hot paths (pytest-benchmark; not in the default run).
 
-    .venv/bin/pytest benchmarks/bench_harness.py --benchmark-only -p no:cacheprovider \\
+    .venv/bin/pytest benchmarks/speed/bench_harness.py --benchmark-only -p no:cacheprovider \\
         --benchmark-columns median,mean,min,rounds
 
 - ``build_instance``: a worker rebuilding a paper-size instance (M=20, K=3, N=5) from its job.
@@ -19,9 +19,9 @@ import random
 
 import pytest
 
-from benchmarks.harness import ResultsStore, build_instance, run_one
-from reports.report import write_report
-from reports.results import SCHEMA_VERSION
+from sarcover.benchmarks.harness import ResultsStore, build_instance, run_one
+from sarcover.reports.report import write_report
+from sarcover.reports.results import SCHEMA_VERSION
 
 SOURCE = {"type": "generate", "M": 20, "K": 3, "N": 5, "instance_seed": 7, "preset": "paper", "overrides": {}}
 JOB = {"key": "k", "instance": "sar-m20-k3-n5-s7", "method": "greedy", "seed": 0, "run": 0,

@@ -2,7 +2,7 @@
 
 Run on one core, CPU time (the machine is shared, so wall time is noisy)::
 
-    .venv/bin/pytest benchmarks/bench_heuristics.py --benchmark-only -p no:cacheprovider \\
+    .venv/bin/pytest benchmarks/speed/bench_heuristics.py --benchmark-only -p no:cacheprovider \\
         --benchmark-timer time.process_time --benchmark-columns median,mean,min,rounds
 
 Each run is a whole method call at the paper's size M=20, K=3, N=5 (``generate(20, 3, 5, seed)``),
@@ -20,10 +20,10 @@ import warnings
 import numpy as np
 import pytest
 
-from formulations.generate import generate
-from formulations.instance import to_top
-from formulations.plan import Status
-from heuristics.pipeline import make_clusterer
+from sarcover.formulations.generate import generate
+from sarcover.formulations.instance import to_top
+from sarcover.formulations.plan import Status
+from sarcover.heuristics.pipeline import make_clusterer
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")  # scikit-learn KMeans: one core like the rest
 
@@ -34,7 +34,7 @@ METHODS = ["adpc-pso", "dpc-pso", "kmeans-pso", "adpc-ga", "adpc-aco", "greedy"]
 @pytest.mark.parametrize("name", METHODS)
 def test_bench_method(benchmark, name):
     """One full run (cluster, route, repair) of a registered method at M=20, K=3, N=5."""
-    from benchmarks.registry import get_method
+    from sarcover.benchmarks.registry import get_method
 
     fn = get_method(name).load()
     cases = itertools.cycle(enumerate(INSTANCES))

@@ -2,12 +2,12 @@
 
 pytest-benchmark file (not collected by the default test run)::
 
-    .venv/bin/pytest benchmarks/bench_exact.py --benchmark-enable -p no:cacheprovider -o addopts=""
+    .venv/bin/pytest benchmarks/speed/bench_exact.py --benchmark-enable -p no:cacheprovider -o addopts=""
 
 Each case is a generated SAR instance with a tight budget (1.15 × the coverage threshold) whose
 number of reachable viewpoints is 8, 12, 16, 20 or 24; each solver runs with 1 thread and with
 all cores, greedy's plan as warm start, a 30 s limit. ``extra_info`` records status, objective
-and bound, so a run that stopped on the limit is visible. ``python -m benchmarks.bench_exact``
+and bound, so a run that stopped on the limit is visible. ``python benchmarks/speed/bench_exact.py``
 prints the same comparison as a table (median over the seeds of each size).
 """
 
@@ -21,12 +21,12 @@ import time
 import highspy
 import numpy as np
 
-from formulations.cpsat import solve_cpsat
-from formulations.generate import generate
-from formulations.instance import TOPInstance, to_top
-from formulations.milp import solve_milp
-from formulations.verify import verify
-from heuristics.greedy import greedy
+from sarcover.formulations.cpsat import solve_cpsat
+from sarcover.formulations.generate import generate
+from sarcover.formulations.instance import TOPInstance, to_top
+from sarcover.formulations.milp import solve_milp
+from sarcover.formulations.verify import verify
+from sarcover.heuristics.greedy import greedy
 
 SIZES = (8, 12, 16, 20, 24)
 TIME_LIMIT = 30.0
@@ -123,7 +123,7 @@ def summarise(rows: list[dict]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m benchmarks.bench_exact", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python benchmarks/speed/bench_exact.py", description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", type=int, nargs="+", default=list(SIZES))
     ap.add_argument("--count", type=int, default=3, help="instances per size")
     ap.add_argument("--threads", type=int, nargs="+", default=list(THREADS))

@@ -1,6 +1,6 @@
 """Speed of `milp` (pytest-benchmark; not in the default test run).
 
-Run: ``.venv/bin/pytest benchmarks/bench_milp.py --benchmark-only -p no:cacheprovider``.
+Run: ``.venv/bin/pytest benchmarks/speed/bench_milp.py --benchmark-only -p no:cacheprovider``.
 Times: building the Pyomo model for a 30-customer TOP instance, and solving small instances to
 proven optimality with one HiGHS thread.
 """
@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from formulations.io import read_top
-from formulations.milp import build_milp, solve_milp
-from formulations.plan import Status
-from formulations.preprocess import prune_arcs
+from sarcover.formulations.io import read_top
+from sarcover.formulations.milp import build_milp, solve_milp
+from sarcover.formulations.plan import Status
+from sarcover.formulations.preprocess import prune_arcs
 
 TOP_DIR = Path(__file__).resolve().parent / "instances" / "top"
 

@@ -1,6 +1,6 @@
 """Speed of the peer heuristics `routing` (OR-Tools) and `pyvrp` beside `greedy` (pytest-benchmark).
 
-Run: ``.venv/bin/pytest benchmarks/bench_peers.py --benchmark-only -p no:cacheprovider``.
+Run: ``.venv/bin/pytest benchmarks/speed/bench_peers.py --benchmark-only -p no:cacheprovider``.
 Per-run time at the paper's M=20, K=3, N=5 preset and on a 31-customer TOP instance. Both peers
 are single-threaded; `pyvrp` stops after 2000 iterations (reproducible), `routing` after 1000
 solutions or its time cap (10 s; 60 % cold search, the rest only if a group stayed uncovered).
@@ -12,11 +12,11 @@ from pathlib import Path
 
 import pytest
 
-from benchmarks.registry import run_method
-from formulations.generate import generate
-from formulations.instance import to_top
-from formulations.io import read_top
-from formulations.plan import Status
+from sarcover.benchmarks.registry import run_method
+from sarcover.formulations.generate import generate
+from sarcover.formulations.instance import to_top
+from sarcover.formulations.io import read_top
+from sarcover.formulations.plan import Status
 
 TOP_DIR = Path(__file__).resolve().parent / "instances" / "top"
 

@@ -1,6 +1,6 @@
 """Speed of `bp` (pytest-benchmark; not in the default test run).
 
-Run: ``.venv/bin/pytest benchmarks/bench_bp.py --benchmark-only -p no:cacheprovider``.
+Run: ``.venv/bin/pytest benchmarks/speed/bench_bp.py --benchmark-only -p no:cacheprovider``.
 Times: one exact pricing call (unidirectional vs bidirectional labelling, elementary and ng-8)
 on random duals, solving TOP instances to proven optimality (one HiGHS thread), and one SAR
 instance at the paper's scale (M = 20, K = 3, N = 5, seed 4: proven in ~6 s on a shared core).
@@ -13,10 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from formulations.bp import solve_bp
-from formulations.bp.pricing import cheapest_return, full_ng, nearest_ng, price
-from formulations.io import read_top
-from formulations.plan import Status
+from sarcover.formulations.bp import solve_bp
+from sarcover.formulations.bp.pricing import cheapest_return, full_ng, nearest_ng, price
+from sarcover.formulations.io import read_top
+from sarcover.formulations.plan import Status
 
 TOP_DIR = Path(__file__).resolve().parent / "instances" / "top"
 
@@ -49,8 +49,8 @@ def test_bench_solve_bp(benchmark, name):
 
 def test_bench_solve_bp_sar(benchmark):
     """M = 20 targets, K = 3 views, N = 5 UAVs (paper preset, seed 4): time to proven optimality."""
-    from formulations.generate import generate
-    from formulations.instance import to_top
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
 
     inst = to_top(generate(20, 3, 5, 4))
     result = benchmark.pedantic(lambda: solve_bp(inst, time_limit=120.0), rounds=1, iterations=1)

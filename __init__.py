@@ -1,0 +1,1 @@
+"""sarcover: exact and heuristic benchmarking for multi-view SAR-UAV coverage path planning."""
