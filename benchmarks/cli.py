@@ -109,8 +109,9 @@ def _add_solve(sub):
 
 
 def _cmd_solve(args) -> int:
-    from sarcover.benchmarks.registry import get_method, result_record, run_method
+    from sarcover.benchmarks.registry import get_method, run_method
     from sarcover.formulations.io import load_instance
+    from sarcover.formulations.records import outcome
 
     spec = get_method(args.method)
     if args.plot and not Path(args.plot).parent.exists():
@@ -120,10 +121,10 @@ def _cmd_solve(args) -> int:
         from sarcover.benchmarks.harness import warm_up_methods
 
         warm_up_methods([spec.name], sys.stderr)
-    result, report = run_method(spec.name, instance, seed=args.seed, time_limit=args.time_limit)
-    record = result_record(result, report, instance)
+    run = run_method(spec.name, instance, seed=args.seed, time_limit=args.time_limit)
+    record = {**outcome(run, instance), "exact": spec.exact}
     if args.plot:
-        _write_plot(instance, result, record, args.plot)
+        _write_plot(instance, run, record, args.plot)
     if args.json:
         print(json.dumps(record))
     else:
@@ -131,14 +132,14 @@ def _cmd_solve(args) -> int:
     return 0
 
 
-def _write_plot(instance, result, record, path):
+def _write_plot(instance, run, record, path):
     import matplotlib.pyplot as plt
 
     from sarcover.reports.plots import plot_plan
 
     cov = f"{100 * record['coverage']:.1f}%" if record["coverage"] is not None else "no plan"
     fig, ax = plt.subplots(figsize=(7, 7))
-    plot_plan(instance, result.plan if record["valid"] else None, ax=ax,
+    plot_plan(instance, run.plan if run.valid else None, ax=ax,
               title=f"{instance.name}: {record['method']} ({record['status']}), coverage {cov}")
     fig.tight_layout()
     fig.savefig(path, dpi=120)

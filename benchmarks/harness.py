@@ -14,7 +14,7 @@
   deadline is recorded as ``time_limit`` and its thread is abandoned; a worker that dies is
   retried by Dask and then recorded as ``error``.
 - Rows are appended to ``RESULTS_DIR/results.jsonl`` by the parent as each job finishes (see
-  :mod:`sarcover.reports.results` for the format).
+  :mod:`sarcover.formulations.records` for the format).
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ from multiprocessing.connection import wait
 from pathlib import Path
 
 from sarcover.formulations.errors import SarcoverError
-from sarcover.reports.results import RESULTS_FILE, SCHEMA_VERSION, read_rows
+from sarcover.formulations.records import FIELDS, RESULTS_FILE, SCHEMA_VERSION, outcome, read_rows
 from sarcover.benchmarks.registry import get_method, warm_up
 from sarcover.benchmarks.suite import Suite
 
@@ -99,22 +99,22 @@ def _now() -> str:
 
 
 def base_row(job: dict) -> dict:
-    """The identity part of a row, plus empty outcome fields."""
+    """A row of the schema's fields (:data:`~sarcover.formulations.records.FIELDS`, in order): the
+    job's identity and provenance, and the outcome of a job that has not run (an error)."""
     src = job["source"]
     source = {k: v for k, v in src.items() if k not in ("exact", "reference")}
-    return {
+    row = dict.fromkeys(FIELDS)
+    row.update({
         "schema": SCHEMA_VERSION, "key": job["key"], "suite": job.get("suite"),
         "instance": job["instance"], "method": job["method"], "exact": src.get("exact"),
         "seed": job["seed"], "run": job["run"], "source": source,
         "kind": "sar" if src["type"] == "generate" else None,
         "M": src.get("M"), "K": src.get("K"), "N": src.get("N"), "instance_seed": src.get("instance_seed"),
-        "n_nodes": None, "n_groups": None, "n_vehicles": None, "reference": src.get("reference"),
-        "status": "error", "objective": None, "bound": None, "coverage": None, "covered": None,
-        "routes": None, "energy": None, "energy_used": None, "e_max": None, "valid": False,
-        "reason": "", "info": {}, "runtime_s": None, "wall_s": None, "time_limit": job["time_limit"],
-        "threads": None, "workers": job.get("workers"), "cpu_s": None, **environment(), "pid": os.getpid(),
-        "finished_at": None,
-    }
+        "reference": src.get("reference"),
+        "termination": "error", "solution": "none", "status": "error", "valid": False, "reason": "", "info": {},
+        "time_limit": job["time_limit"], "workers": job.get("workers"), **environment(), "pid": os.getpid(),
+    })
+    return row
 
 
 def run_one(job: dict) -> dict:
@@ -122,23 +122,20 @@ def run_one(job: dict) -> dict:
     t0, c0 = time.perf_counter(), time.thread_time()
     row = base_row(job)
     try:
-        from sarcover.benchmarks.registry import result_record, run_method
+        from sarcover.benchmarks.registry import run_method
 
         instance = cached_instance(job["source"])
         row.update(kind=instance.kind, n_nodes=instance.n_nodes, n_groups=len(instance.groups),
                    n_vehicles=instance.n_vehicles, e_max=instance.budget)
-        result, report = run_method(job["method"], instance, seed=job["seed"], time_limit=job["time_limit"])
-        rec = result_record(result, report, instance)
-        rec.pop("instance", None)
-        rec.pop("exact", None)
+        run = run_method(job["method"], instance, seed=job["seed"], time_limit=job["time_limit"])
+        rec = outcome(run, instance)
+        rec.pop("instance")
         row.update(rec)
-        if rec["energy"] is not None:
-            row["energy_used"] = float(sum(rec["energy"]))
-        row["threads"] = result.info.get("threads")
+        row["threads"] = run.info.get("threads")
     except BaseException as exc:  # noqa: BLE001 - a job must never take the harness down
         if isinstance(exc, KeyboardInterrupt):
             raise
-        row["status"] = "error"
+        row.update(termination="error", solution="none", status="error")
         row["reason"] = f"harness: {type(exc).__name__}: {exc}"
         row["info"] = {"traceback": traceback.format_exc(limit=-3).strip().splitlines()}
     row["wall_s"] = time.perf_counter() - t0
@@ -152,7 +149,8 @@ def run_one(job: dict) -> dict:
 def failed_row(job: dict, status: str, reason: str, elapsed: float) -> dict:
     """The row of a job whose worker was killed or died (no result came back)."""
     row = base_row(job)
-    row.update(status=status, reason=reason, runtime_s=elapsed, wall_s=elapsed, finished_at=_now())
+    row.update(termination=status, solution="none", status=status, reason=reason, runtime_s=elapsed,
+               wall_s=elapsed, finished_at=_now())
     row["pid"] = None
     return _clean(row)
 

@@ -1,13 +1,21 @@
-"""The method registry: every solver and heuristic, one signature, one front door.
+"""The method registry: every method's entry point, one line each in :data:`METHODS`.
 
-A method is a picklable module-level function::
+A method is a function with one signature::
 
-    method(instance: TOPInstance, *, seed: int, time_limit: float) -> Result
+    method(instance: TOPInstance, *, seed: int, time_limit: float | None) -> Result
 
-Entries name their function as ``"module:function"`` and are imported on first use, so that
-listing methods (or running a heuristic) does not pay for importing every solver library.
-:func:`run_method` is the only way results are counted: it never raises, and it re-verifies
-every plan with the independent verifier.
+Where a method's code lives follows one rule: ``formulations/`` holds the problem and the exact
+methods (a model handed to a solver that proves bounds: the Pyomo MILP on HiGHS, CP-SAT,
+branch-and-price on HiGHS); ``heuristics/`` holds every method that proves nothing, ours (greedy,
+the paper's cluster-then-route pipelines) and the peers built on a library's heuristic search
+(OR-Tools routing, PyVRP). This module composes them: the exact methods start from greedy's plan
+(:func:`warm_started`, written once for all three), and bp also gets PyVRP as its primal
+heuristic, which ``formulations`` may not import.
+
+Each entry point imports its code on first call (the import line names it), so listing the
+methods or running a heuristic does not import every solver library. :func:`run_method` is the
+only way results are counted: it never raises, and it hands the method's result to
+:func:`~sarcover.formulations.result.verified_result`, which re-verifies every plan.
 """
 
 from __future__ import annotations
@@ -19,64 +27,146 @@ from dataclasses import dataclass
 from typing import Callable
 
 from sarcover.formulations.errors import SarcoverError
+from sarcover.formulations.history import shifted
 from sarcover.formulations.instance import TOPInstance, precheck
-from sarcover.formulations.plan import Result, Status
-from sarcover.formulations.verify import VerificationReport, verify
+from sarcover.formulations.result import Result, Termination, VerifiedResult, verified_result
 
 
+# -- composition shared by the exact methods -------------------------------------------------------
+def warm_started(solve: Callable[..., Result], instance: TOPInstance, *, seed: int,
+                 time_limit: float | None, **options) -> Result:
+    """``solve`` started from greedy's plan (when greedy finds one), within the same time limit.
+
+    Greedy costs milliseconds; its plan becomes the solver's ``warm_start`` (MIP start, CP-SAT
+    hint, bp's first columns and incumbent), so a run the limit stops still returns a plan that
+    covers every group whenever greedy found one. The solver gets what greedy left of the limit;
+    the returned runtime and the anytime history count from this call, greedy included.
+    """
+    from sarcover.heuristics.greedy import greedy
+
+    t0 = time.perf_counter()
+    plan = greedy(instance, seed=seed).plan
+    spent = time.perf_counter() - t0
+    left = None if time_limit is None else max(time_limit - spent, 0.01)
+    result = solve(instance, seed=seed, time_limit=left, warm_start=plan, **options)
+    result.runtime_s = time.perf_counter() - t0
+    if "history" in result.info:
+        result.info["history"] = shifted(result.info["history"], spent)
+    result.info["warm_start_prize"] = (float(sum(instance.prizes[v] for v in plan.visited))
+                                       if plan is not None else None)
+    return result
+
+
+# -- entry points ----------------------------------------------------------------------------------
+def greedy(instance, *, seed=0, time_limit=None) -> Result:
+    from sarcover.heuristics.greedy import greedy
+
+    return greedy(instance, seed=seed, time_limit=time_limit)
+
+
+def paper_pipeline(clusterer: str, router: str) -> Callable[..., Result]:
+    """The paper's method family: ``clusterer`` clusters, ``router`` tours, energy repair."""
+
+    def run(instance, *, seed=0, time_limit=None) -> Result:
+        from sarcover.heuristics.pipeline import cluster_then_route
+
+        return cluster_then_route(instance, clusterer, router, seed=seed, time_limit=time_limit)
+
+    run.__name__ = run.__qualname__ = f"{clusterer}_{router}"
+    return run
+
+
+def routing(instance, *, seed=0, time_limit=60.0) -> Result:
+    from sarcover.heuristics.ortools_routing import routing
+
+    return routing(instance, seed=seed, time_limit=time_limit)
+
+
+def pyvrp(instance, *, seed=0, time_limit=60.0) -> Result:
+    from sarcover.heuristics.pyvrp_ils import pyvrp
+
+    return pyvrp(instance, seed=seed, time_limit=time_limit)
+
+
+def milp(instance, *, seed=0, time_limit=60.0) -> Result:
+    from sarcover.formulations.milp import solve_milp
+
+    return warm_started(solve_milp, instance, seed=seed, time_limit=time_limit, threads=1)
+
+
+def cpsat(instance, *, seed=0, time_limit=60.0) -> Result:
+    from sarcover.formulations.cpsat import solve_cpsat
+
+    return warm_started(solve_cpsat, instance, seed=seed, time_limit=time_limit, threads=1)
+
+
+def bp(instance, *, seed=0, time_limit=60.0) -> Result:
+    from sarcover.formulations.bp import default_cut_gap, default_cut_rounds, solve_bp
+    from sarcover.formulations.bp.pricing import warm_up
+    from sarcover.heuristics.pyvrp_ils import primal_routes
+
+    warm_up()  # numba compilation (or loading it from the disk cache) is not the method's time
+
+    def solve(instance, *, seed, time_limit, warm_start, **options):
+        routes = [list(r) for r in warm_start.routes] if warm_start is not None else None
+        return solve_bp(instance, seed=seed, time_limit=time_limit, initial_routes=routes, **options)
+
+    # cuts from the user's limit (on from 60 s), not from what greedy leaves of it
+    return warm_started(solve, instance, seed=seed, time_limit=time_limit,
+                        cut_rounds=default_cut_rounds(time_limit), cut_gap=default_cut_gap(time_limit),
+                        primal=primal_routes(instance, seed))
+
+
+# numba code compiled before a benchmark's workers start (see :func:`warm_up`)
+def compile_routers() -> None:
+    from sarcover.heuristics.pipeline import warm_up
+
+    warm_up()
+
+
+def compile_bp() -> None:
+    from sarcover.formulations.bp.pricing import warm_up
+
+    warm_up()
+
+
+# -- the registry ----------------------------------------------------------------------------------
 @dataclass(frozen=True)
-class MethodSpec:
+class Method:
     name: str
-    target: str  # "package.module:function"
+    run: Callable[..., Result]
     exact: bool  # True if the method can prove optimality (returns bounds)
     summary: str
-    # "module:function" that compiles the method's numba code (or loads it from numba's disk
-    # cache), so that a benchmark does not charge the compilation to the method's first job
-    warm_up: str | None = None
-
-    def load(self) -> Callable[..., Result]:
-        return _resolve(self.target)
+    # compiles the method's numba code (or loads it from numba's disk cache), so that a
+    # benchmark does not charge the compilation to the method's first job
+    warm_up: Callable[[], None] | None = None
 
 
-def _resolve(target: str) -> Callable:
-    module, func = target.split(":")
-    return getattr(importlib.import_module(module), func)
-
-
-_ROUTERS_JIT = "sarcover.heuristics.pipeline:warm_up"  # the PSO, GA and ACO kernels
-
-_SPECS = [
-    MethodSpec("greedy", "sarcover.heuristics.greedy:greedy", False,
-               "cheapest insertion by prize per energy, groups first (floor baseline)"),
-    MethodSpec("adpc-pso", "sarcover.heuristics.pipeline:adpc_pso", False,
-               "the paper's: ADPC clusters, random-key PSO tours (+2-opt), energy repair and refill",
-               _ROUTERS_JIT),
-    MethodSpec("dpc-pso", "sarcover.heuristics.pipeline:dpc_pso", False,
-               "DPC clusters, random-key PSO tours (+2-opt), energy repair and refill", _ROUTERS_JIT),
-    MethodSpec("kmeans-pso", "sarcover.heuristics.pipeline:kmeans_pso", False,
-               "scikit-learn KMeans clusters, random-key PSO tours (+2-opt), energy repair and refill",
-               _ROUTERS_JIT),
-    MethodSpec("adpc-ga", "sarcover.heuristics.pipeline:adpc_ga", False,
-               "ADPC clusters, GA tours (OX, inversion, elitism; +2-opt), energy repair and refill",
-               _ROUTERS_JIT),
-    MethodSpec("adpc-aco", "sarcover.heuristics.pipeline:adpc_aco", False,
-               "ADPC clusters, elitist ant system tours (+2-opt), energy repair and refill",
-               _ROUTERS_JIT),
-    MethodSpec("cpsat", "sarcover.heuristics.cpsat_warm:cpsat", True,
-               "CP-SAT routes constraint + energy flow, greedy hint, 1 thread; optimal only if proven unscaled"),
-    MethodSpec("routing", "sarcover.heuristics.routing_method:routing", False,
-               "OR-Tools routing, prize disjunctions + energy dimension, guided local search, <=10 s"),
-    MethodSpec("pyvrp", "sarcover.heuristics.pyvrp_method:pyvrp", False,
-               "PyVRP iterated local search, optional clients with prizes, max distance = energy, 2000 its"),
-    MethodSpec("milp", "sarcover.heuristics.milp_warm:milp", True,
-               "time-flow TOP MILP on HiGHS via Pyomo: pruned arcs, cliques, path + connectivity cuts, 1 thread, gap 0"),
-    MethodSpec("bp", "sarcover.heuristics.bp_warm:bp", True,
-               "branch-and-price: route master on HiGHS, ng-route labelling pricing (numba), greedy's routes "
-               "as first columns, PyVRP as primal heuristic once the root leaves the proof open, 1 thread",
-               "sarcover.formulations.bp.pricing:warm_up"),
-]
-
-METHODS: dict[str, MethodSpec] = {spec.name: spec for spec in _SPECS}
+METHODS: dict[str, Method] = {m.name: m for m in [
+    Method("greedy", greedy, False, "cheapest insertion by prize per energy, groups first (floor baseline)"),
+    Method("adpc-pso", paper_pipeline("adpc", "pso"), False,
+           "the paper's: ADPC clusters, random-key PSO tours (+2-opt), energy repair and refill", compile_routers),
+    Method("dpc-pso", paper_pipeline("dpc", "pso"), False,
+           "DPC clusters, random-key PSO tours (+2-opt), energy repair and refill", compile_routers),
+    Method("kmeans-pso", paper_pipeline("kmeans", "pso"), False,
+           "scikit-learn KMeans clusters, random-key PSO tours (+2-opt), energy repair and refill", compile_routers),
+    Method("adpc-ga", paper_pipeline("adpc", "ga"), False,
+           "ADPC clusters, GA tours (OX, inversion, elitism; +2-opt), energy repair and refill", compile_routers),
+    Method("adpc-aco", paper_pipeline("adpc", "aco"), False,
+           "ADPC clusters, elitist ant system tours (+2-opt), energy repair and refill", compile_routers),
+    Method("cpsat", cpsat, True,
+           "CP-SAT routes constraint + energy flow, greedy hint, 1 thread; optimal only if proven unscaled"),
+    Method("routing", routing, False,
+           "OR-Tools routing, prize disjunctions + energy dimension, guided local search, <=10 s"),
+    Method("pyvrp", pyvrp, False,
+           "PyVRP iterated local search, optional clients with prizes, max distance = energy, 2000 its"),
+    Method("milp", milp, True,
+           "time-flow TOP MILP on HiGHS via Pyomo: pruned arcs, cliques, path + connectivity cuts, 1 thread, gap 0"),
+    Method("bp", bp, True,
+           "branch-and-price: route master on HiGHS, ng-route labelling pricing (numba), greedy's routes "
+           "as first columns, PyVRP as primal heuristic once the root leaves the proof open, 1 thread",
+           compile_bp),
+]}
 
 
 class UnknownMethodError(SarcoverError):
@@ -84,111 +174,63 @@ class UnknownMethodError(SarcoverError):
         super().__init__(f"unknown method {name!r}; known: {', '.join(METHODS)}")
 
 
-def warm_up(names) -> list[str]:
-    """Run the warm-up hook of each named method once per process (each hook once, however many
-    methods share it); return the hooks run now. A failing hook is skipped: the method's own
-    run then reports the problem in its row. Forked benchmark workers inherit the compiled code."""
-    ran = []
-    for name in names:
-        try:
-            target = get_method(name).warm_up
-        except UnknownMethodError:
-            continue
-        if target is None or target in _WARMED:
-            continue
-        _WARMED.add(target)
-        try:
-            _resolve(target)()
-        except Exception:  # noqa: BLE001 - the job itself will say what is wrong
-            continue
-        ran.append(target)
-    return ran
-
-
-_WARMED: set[str] = set()
-
-
-def get_method(name: str) -> MethodSpec:
+def get_method(name: str) -> Method:
     """The registered method ``name``, or an ad hoc one named ``"module:function"``.
 
-    Ad hoc methods (as a suite may name them) are resolved on each call and never added to
+    Ad hoc methods (as a suite may name them) are imported on each call and never added to
     :data:`METHODS`, so listing the registry always shows the built-in methods only.
     """
     try:
         return METHODS[name]
     except KeyError:
-        if ":" in name:
-            return MethodSpec(name, name, False, "ad hoc (named by a suite)")
-        raise UnknownMethodError(name) from None
+        if ":" not in name:
+            raise UnknownMethodError(name) from None
+    module, func = name.split(":", 1)
+    try:
+        run = getattr(importlib.import_module(module), func)
+    except (ImportError, AttributeError, ValueError) as exc:
+        raise SarcoverError(f"method {name!r}: cannot import {func!r} from {module!r} ({exc})") from None
+    return Method(name, run, False, "ad hoc (named by a suite)")
 
 
-def run_method(
-    name: str, instance: TOPInstance, *, seed: int = 0, time_limit: float = 60.0
-) -> tuple[Result, VerificationReport | None]:
-    """Run a registered method, verify its plan, and return (result, verifier report).
+def warm_up(names) -> list[str]:
+    """Run the warm-up hook of each named method once per process (each hook once, however many
+    methods share it); return the names of the hooks run now. A failing hook is skipped: the
+    method's own run then reports the problem in its row. Forked benchmark workers inherit the
+    compiled code."""
+    ran = []
+    for name in names:
+        hook = METHODS[name].warm_up if name in METHODS else None
+        if hook is None or hook in _WARMED:
+            continue
+        _WARMED.add(hook)
+        try:
+            hook()
+        except Exception:  # noqa: BLE001 - the job itself will say what is wrong
+            continue
+        ran.append(hook.__name__)
+    return ran
 
-    Never raises. A failing method, a plan the verifier rejects, or a bound below the verified
-    objective all come back as status ERROR with the reason. The objective is always the
-    verifier's, never the method's own claim.
+
+_WARMED: set = set()
+
+
+def run_method(name: str, instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0
+               ) -> VerifiedResult:
+    """Run a method and return its verified result. Never raises.
+
+    The pre-check's infeasibility proof, a failing method, a plan the verifier rejects, or a bound
+    below the verified objective all come back as a result with the reason; the objective is
+    always the verifier's, never the method's own claim.
     """
-    spec = get_method(name)
     t0 = time.perf_counter()
     reason = precheck(instance)
     if reason is not None:
-        return Result(name, Status.INFEASIBLE, reason=reason, runtime_s=time.perf_counter() - t0), None
+        return VerifiedResult.failed(name, Termination.INFEASIBLE, reason, time.perf_counter() - t0)
     try:
-        result = spec.load()(instance, seed=seed, time_limit=time_limit)
+        result = get_method(name).run(instance, seed=seed, time_limit=time_limit)
     except Exception as exc:  # a method bug must not stop a benchmark
         tb = traceback.format_exc(limit=-3).strip().splitlines()
-        return Result(
-            name, Status.ERROR, reason=f"{type(exc).__name__}: {exc}",
-            runtime_s=time.perf_counter() - t0, info={"traceback": tb},
-        ), None
-    result.method = name
-    if result.runtime_s <= 0.0:
-        result.runtime_s = time.perf_counter() - t0
-    report = None
-    if result.plan is not None:
-        report = verify(instance, result.plan)
-        if not report.valid:
-            result.info["claimed_status"] = str(result.status)
-            result.status = Status.ERROR
-            result.reason = "verifier rejected the plan: " + "; ".join(report.violations[:5])
-            result.objective = None
-            return result, report
-        result.objective = report.prize
-    elif result.status in (Status.OPTIMAL, Status.FEASIBLE):
-        result.info["claimed_status"] = str(result.status)
-        result.status = Status.ERROR
-        result.reason = f"status {result.info['claimed_status']} without a plan"
-    if result.bound is not None and result.objective is not None:
-        if result.bound < result.objective - 1e-6 * max(1.0, abs(result.objective)):
-            result.info["claimed_status"] = str(result.status)
-            result.status = Status.ERROR
-            result.reason = f"bound {result.bound:g} below verified objective {result.objective:g}"
-    if result.status == Status.OPTIMAL and result.bound is None:
-        result.bound = result.objective
-    return result, report
-
-
-def result_record(result: Result, report: VerificationReport | None, instance: TOPInstance) -> dict:
-    """Flat JSON-ready record of a run (the CLI's --json output and the harness row)."""
-    routes = [list(r) for r in result.plan.routes] if result.plan is not None else None
-    total = instance.total_prize
-    return {
-        "instance": instance.name,
-        "method": result.method,
-        "exact": get_method(result.method).exact if result.method in METHODS else None,
-        "status": str(result.status),
-        "objective": result.objective,
-        "bound": result.bound,
-        "coverage": (result.objective / total if total > 0 else 0.0) if result.objective is not None else None,
-        "covered": report.covered if report is not None and report.valid else None,
-        "routes": routes,
-        "energy": report.energy if report is not None else None,
-        "e_max": instance.budget,
-        "runtime_s": result.runtime_s,
-        "valid": bool(report is not None and report.valid),
-        "reason": result.reason,
-        "info": {k: v for k, v in result.info.items() if k != "traceback"},
-    }
+        return VerifiedResult.failed(name, Termination.ERROR, f"{type(exc).__name__}: {exc}",
+                                     time.perf_counter() - t0, info={"traceback": tb})
+    return verified_result(instance, result, method=name, runtime_s=time.perf_counter() - t0)

@@ -76,7 +76,7 @@ def confirm(spec: str, time_limit: float) -> dict | None:
     inst = load_spec(spec)
     out = {}
     for name in ("milp", "cpsat"):
-        res, _ = run_method(name, inst, time_limit=time_limit)
+        res = run_method(name, inst, time_limit=time_limit)
         out[name] = res
     a, b = out["milp"], out["cpsat"]
     row = {"spec": spec, "milp_s": f"{a.runtime_s:.3f}", "cpsat_s": f"{b.runtime_s:.3f}"}

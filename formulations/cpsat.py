@@ -39,7 +39,7 @@ truly feasible and CP-SAT proved it optimal, it is the true optimum (optimal for
 feasible for the original): status OPTIMAL. Only if the relaxed optimum overruns the true budget
 by that last 1e-6·B (a route tight to within S⁻¹ per arc) is the safe model solved in the
 remaining time, with the objective capped at the relaxed bound; OPTIMAL is reported only if its
-value reaches that bound, otherwise FEASIBLE with the relaxed bound. So scaling can cost a proof
+value reaches that bound, otherwise a plan without proof (termination COMPLETED) with the relaxed bound. So scaling can cost a proof
 (never correctness): a reported OPTIMAL is always the optimum of the verifier's problem.
 
 Prizes must be integers or decimals with at most 6 digits; they are scaled by the smallest power
@@ -55,10 +55,10 @@ as ⌈bound - 1e-6⌉ / prize scale: the relaxed model is a relaxation of the tr
 are valid. The safe model is a restriction (capped at the relaxed bound), so its bounds say
 nothing about the true problem and are never recorded; only its verified plans are.
 
-Warm start: ``solve_cpsat(..., hint=plan)`` passes a plan as a CP-SAT hint. Formulations do not
-import heuristics, so the registered ``cpsat`` method runs without a hint (CP-SAT's own first
-solutions arrive within milliseconds on these sizes); callers that have a heuristic plan may
-pass it.
+Warm start: ``solve_cpsat(..., warm_start=plan)`` passes a plan as a CP-SAT hint; it changes
+neither the model nor the proof, only where the search starts. The registered ``cpsat`` method
+(:mod:`sarcover.benchmarks.registry`) passes greedy's plan: with one worker CP-SAT alone found
+no plan within 60 s on some 30-node TOP instances that the hint solves quickly.
 """
 
 from __future__ import annotations
@@ -72,7 +72,8 @@ from ortools.sat.python import cp_model
 from sarcover.formulations.errors import SarcoverError
 from sarcover.formulations.history import History
 from sarcover.formulations.instance import TOPInstance, precheck
-from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.result import Result, Termination
 from sarcover.formulations.verify import REL_TOL, verify
 
 TARGET_SCALED_BUDGET = 1e7
@@ -379,7 +380,7 @@ def solve_cpsat(
     seed: int = 0,
     time_limit: float | None = 60.0,
     threads: int = 1,
-    hint: Plan | None = None,
+    warm_start: Plan | None = None,
     model: str = "multi",
     flow: bool = True,
     linearization: int = 2,
@@ -393,32 +394,30 @@ def solve_cpsat(
     def left() -> float | None:
         return None if time_limit is None else time_limit - (time.perf_counter() - t0)
 
-    def done(status, plan=None, bound=None, reason=""):
+    def done(termination, plan=None, bound=None, reason=""):
         prize = verify(instance, plan).prize if plan is not None else None
-        if status != Status.OPTIMAL and best["plan"] is not None and (prize is None or best["prize"] > prize):
+        if termination != Termination.OPTIMAL and best["plan"] is not None and (prize is None or best["prize"] > prize):
             # a truly feasible plan seen during the search beats the final one (e.g. a repaired one)
             plan, prize = best["plan"], best["prize"]
-            if status == Status.NO_PLAN:
-                status = Status.FEASIBLE
             reason = (reason + "; " if reason else "") + "returned the best verified plan seen during the search"
         info["history"] = hist.finish(prize, bound)
-        return Result("cpsat", status, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
+        return Result("cpsat", termination, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
                       reason=reason, info=info)
 
     reason = precheck(instance)
     if reason is not None:
-        return done(Status.INFEASIBLE, reason=reason)
+        return done(Termination.INFEASIBLE, reason=reason)
     pscale = prize_scale(instance.prizes)
     iprize = np.round(instance.prizes * pscale).astype(np.int64)
     relaxed = _Data(instance, relaxed=True)
     info.update(cost_scale=relaxed.scale, prize_scale=pscale, reachable=len(relaxed.nodes),
                 arcs=len(relaxed.arcs))
     if not relaxed.nodes:  # nothing reachable and no groups (precheck): the empty plan
-        return done(Status.OPTIMAL, plan=_pad([], instance.n_vehicles), bound=0.0)
+        return done(Termination.OPTIMAL, plan=_pad([], instance.n_vehicles), bound=0.0)
 
     built = _Model(relaxed, iprize, model, None, flow)
-    if hint is not None:
-        built.add_hint(hint)
+    if warm_start is not None:
+        built.add_hint(warm_start)
     solver = _solver(left(), threads, seed, linearization)
     # CP-SAT's bound on the scaled objective; the relaxed model's bound is valid for the true problem.
     solver.best_bound_callback = lambda b: hist.update(bound=math.ceil(b - 1e-6) / pscale)
@@ -426,17 +425,17 @@ def solve_cpsat(
     info["relaxed_status"] = solver.status_name(st)
     info["relaxed_wall_s"] = solver.wall_time
     if st == cp_model.INFEASIBLE:
-        return done(Status.INFEASIBLE, reason="CP-SAT proved that no plan covers every group "
+        return done(Termination.INFEASIBLE, reason="CP-SAT proved that no plan covers every group "
                     "(relaxed rounding, so the proof holds for the exact costs)")
     if st == cp_model.MODEL_INVALID:
-        return done(Status.ERROR, reason="CP-SAT: model invalid " + built.m.validate())
+        return done(Termination.ERROR, reason="CP-SAT: model invalid " + built.m.validate())
     if st not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
         # No incumbent: CP-SAT's best_objective_bound is not reliable then (it reads 0); the last
         # bound its callback reported is (None if it reported none).
-        if hint is not None and verify(instance, hint).valid:
-            return done(Status.TIME_LIMIT, hint, hist.bound,
+        if warm_start is not None and verify(instance, warm_start).valid:
+            return done(Termination.TIME_LIMIT, warm_start, hist.bound,
                         reason="time limit; CP-SAT found no plan, the hint is returned")
-        return done(Status.TIME_LIMIT, bound=hist.bound, reason=f"CP-SAT found no plan ({solver.status_name(st)})")
+        return done(Termination.TIME_LIMIT, bound=hist.bound, reason=f"CP-SAT found no plan ({solver.status_name(st)})")
     ivalue = int(round(solver.objective_value))
     # Integer objective: CP-SAT's bound is integral; ceil(x - 1e-6) never rounds it down.
     ibound = math.ceil(solver.best_objective_bound - 1e-6) if st == cp_model.FEASIBLE else ivalue
@@ -448,17 +447,17 @@ def solve_cpsat(
     info["relaxed_plan_valid"] = truly
     if truly:
         if st == cp_model.OPTIMAL:
-            return done(Status.OPTIMAL, plan, bound)
-        return done(Status.TIME_LIMIT, plan, bound, reason="time limit before optimality was proven")
+            return done(Termination.OPTIMAL, plan, bound)
+        return done(Termination.TIME_LIMIT, plan, bound, reason="time limit before optimality was proven")
     if st == cp_model.FEASIBLE:  # out of time: repair the relaxed incumbent
         fixed = _repair(instance, routes)
-        return done(Status.TIME_LIMIT, fixed, bound, reason="time limit; relaxed incumbent repaired"
+        return done(Termination.TIME_LIMIT, fixed, bound, reason="time limit; relaxed incumbent repaired"
                     if fixed else "time limit; the relaxed incumbent overran the budget")
     # Relaxed optimum overruns the true budget by < #arcs/S: solve the safe rounding.
     safe = _Data(instance, relaxed=False)
     built2 = _Model(safe, iprize, model, ibound, flow)
-    if hint is not None:
-        built2.add_hint(hint)
+    if warm_start is not None:
+        built2.add_hint(warm_start)
     solver2 = _solver(left(), threads, seed, linearization)
     st2 = solver2.solve(built2.m, _Recorder(built2, hist, best))  # plans only: its bounds are not valid
     info["safe_status"] = solver2.status_name(st2)
@@ -466,19 +465,14 @@ def solve_cpsat(
         plan2 = _pad(built2.routes(solver2), instance.n_vehicles)
         value = int(round(solver2.objective_value))
         if value == ibound:
-            return done(Status.OPTIMAL, plan2, bound)
-        status = Status.FEASIBLE if st2 == cp_model.OPTIMAL else Status.TIME_LIMIT
-        return done(status, plan2, bound, reason="integer rounding left a gap: the relaxed-cost "
+            return done(Termination.OPTIMAL, plan2, bound)
+        termination = Termination.COMPLETED if st2 == cp_model.OPTIMAL else Termination.TIME_LIMIT
+        return done(termination, plan2, bound, reason="integer rounding left a gap: the relaxed-cost "
                     "optimum overruns the budget by less than the scaling error")
     fixed = _repair(instance, routes)
     if fixed is not None:
-        return done(Status.TIME_LIMIT if st2 == cp_model.UNKNOWN else Status.FEASIBLE, fixed, bound,
+        return done(Termination.TIME_LIMIT if st2 == cp_model.UNKNOWN else Termination.COMPLETED, fixed, bound,
                     reason="safe-rounding model gave no plan; relaxed optimum repaired")
-    return done(Status.TIME_LIMIT if st2 == cp_model.UNKNOWN else Status.NO_PLAN, None, bound,
+    return done(Termination.TIME_LIMIT if st2 == cp_model.UNKNOWN else Termination.COMPLETED, None, bound,
                 reason="the relaxed-cost plan overruns the budget by the scaling error and the "
                 "safe-rounding model found no plan")
-
-
-def cpsat(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0) -> Result:
-    """Registered method ``cpsat``: :func:`solve_cpsat` with one thread and no warm start."""
-    return solve_cpsat(instance, seed=seed, time_limit=time_limit, threads=1)

@@ -68,7 +68,8 @@ from scipy.sparse.csgraph import maximum_flow
 
 from sarcover.formulations.history import History
 from sarcover.formulations.instance import TOPInstance, precheck
-from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.result import Result, Termination
 from sarcover.formulations.preprocess import (
     ArcGraph,
     floor_to_lattice,
@@ -409,10 +410,10 @@ def solve_milp(
 ) -> Result:
     """Solve ``instance`` exactly with HiGHS (see the module docstring for the method).
 
-    ``warm_start``: a valid plan handed to HiGHS as its first incumbent (formulations cannot import
-    heuristics; the registered ``milp`` method in :mod:`sarcover.heuristics.exact` passes greedy's plan).
+    ``warm_start``: a valid plan handed to HiGHS as its first incumbent (the registered ``milp``
+    method, :mod:`sarcover.benchmarks.registry`, passes greedy's plan).
     ``root_rounds``: rounds of LP connectivity-cut separation before the MIP (0 turns it off).
-    Returns OPTIMAL only when the verified plan reaches HiGHS's proven bound.
+    Terminates OPTIMAL only when the verified plan reaches HiGHS's proven bound.
     """
     t0 = time.perf_counter()
     deadline = None if time_limit is None else t0 + float(time_limit)
@@ -422,19 +423,19 @@ def solve_milp(
     def left() -> float | None:
         return None if deadline is None else max(deadline - time.perf_counter(), 0.0)
 
-    def done(status, plan=None, bound=None, reason=""):
+    def done(termination, plan=None, bound=None, reason=""):
         info["history"] = hist.finish(verify(instance, plan).prize if plan is not None else None, bound)
         info["runtime_model_s"] = round(time.perf_counter() - t0, 4)
-        return Result(METHOD, status, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
+        return Result(METHOD, termination, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
                       reason=reason, info=info)
 
     reason = precheck(instance)
     if reason is not None:
-        return done(Status.INFEASIBLE, reason=reason)
+        return done(Termination.INFEASIBLE, reason=reason)
     g = prune_arcs(instance)
     info.update(nodes=len(g.nodes), arcs=len(g.arcs), arcs_full=g.n_arcs_full)
     if not g.nodes:  # nothing reachable; precheck passed, so there are no groups
-        return done(Status.OPTIMAL, plan=Plan.of([]), bound=0.0, reason="no node is reachable within the budget")
+        return done(Termination.OPTIMAL, plan=Plan.of([]), bound=0.0, reason="no node is reachable within the budget")
     lattice = prize_lattice(instance.prizes[[i - 1 for i in g.nodes]])
     m = build_milp(instance, g, two_cycle=two_cycle, cliques=cliques, paths=paths)
 
@@ -501,7 +502,7 @@ def solve_milp(
         rounds += 1
         tl = left()
         if tl is not None and tl <= 0.0:
-            status = Status.TIME_LIMIT
+            proven = False
             break
         if rounds == 1 and warm_start is not None:
             opt.set_instance(m)
@@ -514,7 +515,7 @@ def solve_milp(
             # The model is bounded (binaries, bounded flow), so "infeasible or unbounded" is infeasible.
             info.update(rounds=rounds, cuts_int=cuts_int, nogoods=nogoods, warm_start=warm)
             what = "target" if instance.kind == "sar" else "group"
-            return done(Status.INFEASIBLE,
+            return done(Termination.INFEASIBLE,
                         reason=f"HiGHS proved that no plan of {instance.n_vehicles} routes within the "
                                f"budget covers every {what}")
         if res.objective_bound is not None and math.isfinite(res.objective_bound):
@@ -524,9 +525,9 @@ def solve_milp(
         hist.update(bound=bound)
         if tc not in (TerminationCondition.convergenceCriteriaSatisfied, TerminationCondition.maxTimeLimit):
             info.update(rounds=rounds)
-            return done(Status.ERROR, plan=best.plan, bound=bound, reason=f"HiGHS stopped: {tc.name}")
+            return done(Termination.ERROR, plan=best.plan, bound=bound, reason=f"HiGHS stopped: {tc.name}")
         if res.incumbent_objective is None:
-            status = Status.TIME_LIMIT
+            proven = False
             break
         res.solution_loader.load_vars()
         xval = _values(m.x)
@@ -553,13 +554,13 @@ def solve_milp(
                 changed = True
         if changed:
             continue
-        status = Status.OPTIMAL if tc == TerminationCondition.convergenceCriteriaSatisfied else Status.TIME_LIMIT
+        proven = tc == TerminationCondition.convergenceCriteriaSatisfied
         break
 
     info.update(rounds=rounds, cuts_int=cuts_int, nogoods=nogoods, warm_start=warm)
     if best.plan is not None and best.prize >= bound - 1e-7 * max(1.0, abs(bound)):
-        return done(Status.OPTIMAL, plan=best.plan, bound=bound)  # a verified plan reaches a proven bound
-    if status == Status.OPTIMAL:  # HiGHS optimal, yet the verified plan is below its bound: never claim it
-        return done(Status.FEASIBLE, plan=best.plan, bound=bound,
+        return done(Termination.OPTIMAL, plan=best.plan, bound=bound)  # a verified plan reaches a proven bound
+    if proven:  # HiGHS optimal, yet the verified plan is below its bound: never claim it
+        return done(Termination.COMPLETED, plan=best.plan, bound=bound,
                     reason="HiGHS reported optimal but the verified plan does not reach its bound")
-    return done(Status.TIME_LIMIT, plan=best.plan, bound=bound, reason="time limit")
+    return done(Termination.TIME_LIMIT, plan=best.plan, bound=bound, reason="time limit")

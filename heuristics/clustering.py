@@ -29,30 +29,9 @@ expansion index. A cluster starts with its centre, so ω_i ≥ 1 and ω_i = 0 ne
 (far centres) make the penalty grow fastest, so far clusters stay small: their UAV spends its
 energy flying out, not imaging.
 
-Defaults, tuned on the paper preset (M=20, K=3, N=5, seeds 0-49, ``adpc-pso``, mean coverage
-with / without the repair's refill step)::
-
-    ξ  |  d_c percentile   2 %            5 %
-    0    (nearest centre)   0.769/0.716    0.779/0.725
-    0.25                    0.761/0.710    0.769/0.720
-    0.5                     0.741/0.685    0.748/0.691
-    1                       0.708/0.611    0.716/0.624
-
-The size penalty costs coverage on this preset (imaging is expensive, E_I = 150 m of flight, so
-the big near-base clusters it creates overflow their budget); ξ = 0.25 keeps the paper's idea at
-a small cost, and d_c stays at Rodriguez & Laio's 2 % (5 % is slightly better here).
-
-Re-measured on the current paper preset (H = 800 m, θ = 40°, E_I = 50; ``adpc-pso`` mean coverage,
-seeds 0-49, with refill)::
-
-    ξ  |  d_c percentile   M20 K3 N5: 2 %   5 %     M20 K6 N5: 2 %   5 %     M20 K3 N2: 2 %   5 %
-    0                         0.841   0.834           0.661   0.662           0.459   0.454
-    0.25                      0.841   0.838           0.655   0.662           0.447   0.469
-    0.5                       0.833   0.835           0.657   0.653           0.448   0.462
-    1                         0.813   0.807           0.624   0.627           0.452   0.444
-
-No setting is clearly better than the default (differences ≤ 0.014, within the ~0.01 standard
-error of 50 instances); ξ ≥ 1 still costs coverage. The defaults (ξ = 0.25, 2 %) stay.
+Defaults: ξ = 0.25 and d_c at the 2nd percentile. A larger ξ costs coverage on the paper preset
+(the big near-base clusters it creates overflow their budget); ξ = 0.25 keeps the paper's idea at a
+small cost. The tuning tables are in ``docs/heuristics.md``.
 
 When there are fewer points than clusters, every point is its own cluster
 (``n_clusters_`` tells how many were made).

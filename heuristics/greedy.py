@@ -17,7 +17,8 @@ import time
 import numpy as np
 
 from sarcover.formulations.instance import TOPInstance
-from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.result import Result, Termination
 from sarcover.heuristics.insertion import RouteSet
 from sarcover.heuristics.repair import Repairer
 
@@ -32,7 +33,7 @@ def greedy(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = N
     missing = repairer.cover(rs, reach)
     if missing is not None:
         what = "target" if instance.kind == "sar" else "group"
-        return Result("greedy", Status.NO_PLAN, reason=f"greedy could not fit a viewpoint of {what} {missing}",
+        return Result("greedy", Termination.COMPLETED, reason=f"greedy could not fit a viewpoint of {what} {missing}",
                       runtime_s=time.perf_counter() - t0)
     repairer.fill(rs, reach)
-    return Result("greedy", Status.FEASIBLE, plan=Plan.of(rs.node_routes()), runtime_s=time.perf_counter() - t0)
+    return Result("greedy", Termination.COMPLETED, plan=Plan.of(rs.node_routes()), runtime_s=time.perf_counter() - t0)

@@ -12,9 +12,8 @@ sequentially here and pairwise by numpy, and such ties may break the other way.
 * :func:`ga_generation` with :func:`ga_children`: one GA generation (elitism, tournaments, OX,
   inversion, fitness); the GA's draws stay in numpy (integers and uniforms interleave).
 
-Measured at M=20, K=3, N=5 (process time, one core, shared machine): the routing stage went from
-~15 ms (PSO), ~18 ms (GA) and ~50 ms (ACO) with per-iteration numpy calls to ~8, ~9 and ~15 ms;
-drawing the PSO's random numbers with numpy is now about a third of its time.
+They exist for speed: the per-iteration numpy calls dominated the routing stage (the timings
+are in ``docs/heuristics.md``).
 
 ``HAVE_NUMBA`` is False when numba cannot be imported; the routers then fall back to numpy.
 """

@@ -1,4 +1,5 @@
-"""Cluster-then-route: the paper's method family, one registered method per (clusterer, router).
+"""Cluster-then-route: the paper's method family, one registered method per (clusterer, router)
+(``adpc-pso`` is ``cluster_then_route(instance, "adpc", "pso")``; see :mod:`sarcover.benchmarks.registry`).
 
 1. Cluster the reachable viewpoints (a viewpoint is reachable if a UAV can fly start → it → end
    within E_max) into N = n_vehicles groups: ADPC, DPC or scikit-learn KMeans (fewer groups if
@@ -22,7 +23,8 @@ from typing import Callable
 import numpy as np
 
 from sarcover.formulations.instance import TOPInstance
-from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.result import Result, Termination
 from sarcover.heuristics.clustering import ADPC, DPC
 from sarcover.heuristics.repair import RepairFailed, Repairer
 from sarcover.heuristics.routing_aco import ACORouter
@@ -71,7 +73,7 @@ def cluster_then_route(
     reinsert: bool = True,
     name: str | None = None,
 ) -> Result:
-    """Run the pipeline and return a Result (FEASIBLE with a plan, or NO_PLAN with a reason)."""
+    """Run the pipeline and return a Result (a plan, or none with a reason)."""
     t0, c0 = time.perf_counter(), time.thread_time()
     name = name or f"{clusterer}-{router}"
     deadline = None if time_limit is None else t0 + float(time_limit)
@@ -80,10 +82,10 @@ def cluster_then_route(
     info: dict = {"clusterer": clusterer, "router": router}
     if reach.size == 0:
         if instance.groups:
-            return Result(name, Status.NO_PLAN, reason="no viewpoint is reachable within E_max",
+            return Result(name, Termination.COMPLETED, reason="no viewpoint is reachable within E_max",
                           runtime_s=time.perf_counter() - t0, info=info)
         empty = Plan.of([[] for _ in range(instance.n_vehicles)])
-        return Result(name, Status.FEASIBLE, plan=empty, runtime_s=time.perf_counter() - t0, info=info)
+        return Result(name, Termination.COMPLETED, plan=empty, runtime_s=time.perf_counter() - t0, info=info)
 
     k = min(instance.n_vehicles, reach.size)
     if clusterer == "kmeans":  # KMeans cannot make more clusters than distinct points
@@ -115,39 +117,14 @@ def cluster_then_route(
         routes = repairer.repair(tours, reinsert=reinsert)
     except RepairFailed as exc:
         info.update(repairer.stats)
-        return Result(name, Status.NO_PLAN, reason=str(exc), runtime_s=time.perf_counter() - t0, info=info)
+        return Result(name, Termination.COMPLETED, reason=str(exc), runtime_s=time.perf_counter() - t0, info=info)
     t3, c3 = time.perf_counter(), time.thread_time()
     info.update(repairer.stats)
     info["time_cluster_s"], info["time_route_s"], info["time_repair_s"] = t1 - t0, t2 - t1, t3 - t2
     info["cpu_cluster_s"], info["cpu_route_s"], info["cpu_repair_s"] = c1 - c0, c2 - c1, c3 - c2  # thread CPU
     routes = [[v - 1 for v in r] for r in routes]
     routes += [[] for _ in range(instance.n_vehicles - len(routes))]
-    return Result(name, Status.FEASIBLE, plan=Plan.of(routes), runtime_s=time.perf_counter() - t0, info=info)
-
-
-def adpc_pso(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:
-    """The paper's method: ADPC clusters, random-key PSO tours, energy repair."""
-    return cluster_then_route(instance, "adpc", "pso", seed=seed, time_limit=time_limit)
-
-
-def dpc_pso(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:
-    """DPC clusters (nearest-denser assignment), PSO tours, energy repair."""
-    return cluster_then_route(instance, "dpc", "pso", seed=seed, time_limit=time_limit)
-
-
-def kmeans_pso(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:
-    """scikit-learn KMeans clusters, PSO tours, energy repair."""
-    return cluster_then_route(instance, "kmeans", "pso", seed=seed, time_limit=time_limit)
-
-
-def adpc_ga(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:
-    """ADPC clusters, GA tours (OX, inversion mutation, elitism), energy repair."""
-    return cluster_then_route(instance, "adpc", "ga", seed=seed, time_limit=time_limit)
-
-
-def adpc_aco(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:
-    """ADPC clusters, elitist ant system tours, energy repair."""
-    return cluster_then_route(instance, "adpc", "aco", seed=seed, time_limit=time_limit)
+    return Result(name, Termination.COMPLETED, plan=Plan.of(routes), runtime_s=time.perf_counter() - t0, info=info)
 
 
 def warm_up() -> None:

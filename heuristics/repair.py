@@ -18,7 +18,7 @@ by 2-opt. Then:
    viewpoint, are inserted by greatest prize per added energy while any fits, then each route
    is 2-opted and the insertion retried once.
 
-If a group is still uncovered the repair fails: the caller reports Status.NO_PLAN (a heuristic
+If a group is still uncovered the repair fails: the caller returns no plan (a heuristic
 never proves infeasibility).
 """
 

@@ -1,4 +1,4 @@
-"""The reference report of issue 7: the paper's experiment reproduced, claim by claim, with gaps.
+"""The reference report: the paper's experiment reproduced, claim by claim, with gaps.
 
 ``write_reference(results_root, out_dir)`` reads the result directories that
 ``python -m sarcover.benchmarks.reproduce`` fills (one per suite: paper-n, paper-k, paper-peers, exact-small,
@@ -22,7 +22,6 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from sarcover.benchmarks.reproduce import SUITES  # noqa: E402  (the suites this report renders, run order)
 from sarcover.reports.results import load_results  # noqa: E402
 
 PAPER = ["adpc-pso", "dpc-pso", "kmeans-pso", "adpc-ga", "adpc-aco"]
@@ -111,8 +110,10 @@ def _paired_best(df: pd.DataFrame, x: str) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def write_reference(root: str | Path, out: str | Path, *, command: str = "python -m sarcover.benchmarks.reproduce",
-                    notes: list[str] | None = None) -> Path:
+def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
+                    command: str = "python -m sarcover.benchmarks.reproduce", notes: list[str] | None = None) -> Path:
+    """Write ``out/README.md`` (with its PNGs and CSVs) from the suites' result directories under
+    ``root``; ``suites`` names them in run order (the run-log table)."""
     root, out = Path(root), Path(out)
     out.mkdir(parents=True, exist_ok=True)
     pn, pk, peers = _load(root, "paper-n"), _load(root, "paper-k"), _load(root, "paper-peers")
@@ -135,7 +136,7 @@ def write_reference(root: str | Path, out: str | Path, *, command: str = "python
     # -- run log
     L += ["## How it was run", ""]
     L += ["| suite | jobs | wall (s) | workers | host cpus | finished |", "|---|---|---|---|---|---|"]
-    for s in SUITES:
+    for s in suites:
         for w in _walls(root, s):
             if not w["jobs"]:
                 continue  # a resume that found everything stored

@@ -3,7 +3,8 @@
 import os
 import time
 
-from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.result import Result, Termination
 
 
 def crash(instance, *, seed=0, time_limit=None):
@@ -30,20 +31,20 @@ def slow_all(instance, *, seed=0, time_limit=None):
 
 def all_optimal(instance, *, seed=0, time_limit=None):
     """Every node on vehicle 1, claimed optimal with bound = total prize (tiny easy instances)."""
-    return Result("all", Status.OPTIMAL, Plan.of([list(range(instance.n_nodes))] + [[]] * (instance.n_vehicles - 1)),
+    return Result("all", Termination.OPTIMAL, Plan.of([list(range(instance.n_nodes))] + [[]] * (instance.n_vehicles - 1)),
                   bound=float(instance.total_prize))
 
 
 def all_but_last(instance, *, seed=0, time_limit=None):
     """Every node but the last on vehicle 1 (9 of 10 on a 10-node unit-prize instance)."""
-    return Result("most", Status.FEASIBLE,
+    return Result("most", Termination.COMPLETED,
                   Plan.of([list(range(instance.n_nodes - 1))] + [[]] * (instance.n_vehicles - 1)))
 
 
 def hog(instance, *, seed=0, time_limit=None):
     """Allocates 3 GB at once: under the suite's memory_mb limit this is a MemoryError."""
     block = bytearray(3 * 1024**3)
-    return Result("hog", Status.NO_PLAN, reason=str(len(block)))
+    return Result("hog", Termination.COMPLETED, reason=str(len(block)))
 
 
 def nap(instance, *, seed=0, time_limit=None):

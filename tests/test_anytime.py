@@ -15,7 +15,7 @@ from sarcover.benchmarks.suite import load_suite
 from sarcover.formulations.history import History, thin
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.io import read_top
-from sarcover.formulations.plan import Status
+from sarcover.formulations.result import Status
 from sarcover.reports.report import write_report
 from sarcover.reports.results import SCHEMA_VERSION
 
@@ -48,7 +48,7 @@ def test_history_on_a_proven_top_instance(method):
     """p2.2.b (published optimum 120): proven fast; the history closes at 120 = objective = bound."""
     opt, status = PUBLISHED["p2.2.b"]
     assert status == "optimal"
-    res, rep = run_method(method, read_top(TOP_DIR / "p2.2.b.txt"), time_limit=10)
+    res = run_method(method, read_top(TOP_DIR / "p2.2.b.txt"), time_limit=10)
     assert res.status == Status.OPTIMAL and res.objective == opt
     h = check_history(res, opt)
     assert h[-1][1:] == [opt, opt]
@@ -59,7 +59,7 @@ def test_history_under_a_time_limit_brackets_the_optimum(method):
     """p1.3.n (optimum 190) is not proven in 1.5 s: every recorded bound is still >= 190."""
     opt, status = PUBLISHED["p1.3.n"]
     assert status == "optimal"
-    res, rep = run_method(method, read_top(TOP_DIR / "p1.3.n.txt"), time_limit=1.5)
+    res = run_method(method, read_top(TOP_DIR / "p1.3.n.txt"), time_limit=1.5)
     assert res.status != Status.ERROR, res.reason
     h = check_history(res, opt)
     assert any(p[2] is not None for p in h)
@@ -70,7 +70,7 @@ def test_history_in_prize_units_with_decimal_prizes(method):
     """Prizes 0.25, 0.5, 0.125 on a line, budget 4: optimum 0.75 by hand (cpsat scales prizes by 1000)."""
     inst = TOPInstance(coords=np.array([[1.0, 0.0], [2.0, 0.0], [3.0, 0.0]]), prizes=np.array([0.25, 0.5, 0.125]),
                        start=np.zeros(2), end=np.zeros(2), budget=4.0, n_vehicles=1)
-    res, _ = run_method(method, inst, time_limit=5)
+    res = run_method(method, inst, time_limit=5)
     assert res.status == Status.OPTIMAL and res.objective == pytest.approx(0.75)
     check_history(res, 0.75)
 

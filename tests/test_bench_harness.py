@@ -14,7 +14,7 @@ import pytest
 from sarcover.benchmarks.cli import main
 from sarcover.benchmarks.harness import run_suite
 from sarcover.benchmarks.suite import load_suite
-from sarcover.reports.results import read_rows
+from sarcover.formulations.records import FIELDS, SCHEMA_VERSION, read_rows
 
 TESTS = Path(__file__).resolve().parent
 ROOT = TESTS.parent
@@ -59,7 +59,9 @@ def test_small_suite_end_to_end_cli(tmp_path, capsys):
         if r["kind"] == "sar":
             assert r["objective"] == pytest.approx(r["coverage"] * r["M"] * r["K"])
         assert r["energy_used"] <= r["e_max"] * r["n_vehicles"] * (1 + 1e-9)
-        assert r["versions"]["numpy"] and r["host"] and r["schema"] == 1 and r["workers"] == 2
+        assert r["versions"]["numpy"] and r["host"] and r["schema"] == SCHEMA_VERSION and r["workers"] == 2
+        assert list(r) == list(FIELDS)  # the one schema, in its order
+        assert (r["termination"], r["solution"]) in (("completed", "feasible"), ("optimal", "optimal"))
         assert 0 < r["cpu_s"] <= r["wall_s"] + 0.05  # the job thread's CPU time, within its wall time
     sar = [r for r in rows if r["kind"] == "sar"]
     assert {(r["N"], r["instance_seed"]) for r in sar} == {(2, 0), (2, 1), (3, 0), (3, 1)}
@@ -288,13 +290,13 @@ def test_ad_hoc_methods_do_not_join_the_registry(tmp_path):
     from sarcover.benchmarks.registry import METHODS, get_method, run_method
     from sarcover.formulations.generate import generate
     from sarcover.formulations.instance import to_top
-    from sarcover.formulations.plan import Status
+    from sarcover.formulations.result import Status
 
     before = set(METHODS)
     inst = to_top(generate(2, 2, 1, 0))
-    result, _ = run_method("bench_methods:all_but_last", inst, time_limit=5.0)
+    result = run_method("bench_methods:all_but_last", inst, time_limit=5.0)
     assert result.status == Status.FEASIBLE
-    assert get_method("bench_methods:nap").target == "bench_methods:nap"
+    assert get_method("bench_methods:nap").name == "bench_methods:nap"
     assert set(METHODS) == before
 
 
@@ -347,7 +349,7 @@ before = compiled()
 hooks = warm_up(list(METHODS))
 warmed = compiled()
 inst = to_top(generate(6, 3, 2, seed=1))
-statuses = {m: str(run_method(m, inst, seed=0, time_limit=10)[0].status)
+statuses = {m: str(run_method(m, inst, seed=0, time_limit=10).status)
             for m in ("bp", "adpc-pso", "dpc-pso", "kmeans-pso", "adpc-ga", "adpc-aco")}
 print(json.dumps({"before": before, "hooks": hooks, "warmed": warmed, "after": compiled(),
                   "statuses": statuses}))
@@ -361,7 +363,7 @@ def test_warm_up_leaves_nothing_for_the_jobs_to_compile():
     out = subprocess.run([sys.executable, "-c", WARM_CHECK], cwd=ROOT, capture_output=True,
                          text=True, timeout=600, check=True)
     data = json.loads(out.stdout.strip().splitlines()[-1])
-    assert sorted(data["hooks"]) == ["sarcover.formulations.bp.pricing:warm_up", "sarcover.heuristics.pipeline:warm_up"]
+    assert sorted(data["hooks"]) == ["compile_bp", "compile_routers"]
     assert sum(data["before"].values()) == 0  # a fresh process: nothing compiled yet
     assert data["warmed"]["sarcover.formulations.bp.pricing._label"] > 0
     assert data["warmed"]["sarcover.heuristics.kernels.pso_iterations"] > 0
@@ -370,21 +372,34 @@ def test_warm_up_leaves_nothing_for_the_jobs_to_compile():
 
 
 def test_warm_up_runs_each_hook_once_and_skips_a_broken_one(monkeypatch):
+    """Methods that share a hook compile once per process; a hook that fails is skipped."""
+    import dataclasses
+
     import sarcover.benchmarks.registry as registry
 
     calls = []
-    monkeypatch.setattr(registry, "_WARMED", set())
-    monkeypatch.setattr(registry, "_resolve", lambda target: (lambda: calls.append(target)))
-    assert registry.warm_up(["adpc-pso", "dpc-pso", "greedy", "bp", "tests.x:y"]) == [
-        "sarcover.heuristics.pipeline:warm_up", "sarcover.formulations.bp.pricing:warm_up"]
-    assert registry.warm_up(["adpc-ga", "bp"]) == []  # already done in this process
-    assert len(calls) == 2
 
-    def broken(target):
+    def hook_a():
+        calls.append("a")
+
+    def hook_b():
+        calls.append("b")
+
+    def broken():
         raise ImportError("no such module")
 
+    methods = dict(registry.METHODS)
+    for name in ("adpc-pso", "dpc-pso", "adpc-ga"):
+        methods[name] = dataclasses.replace(methods[name], warm_up=hook_a)
+    methods["bp"] = dataclasses.replace(methods["bp"], warm_up=hook_b)
+    monkeypatch.setattr(registry, "METHODS", methods)
     monkeypatch.setattr(registry, "_WARMED", set())
-    monkeypatch.setattr(registry, "_resolve", broken)
+    assert registry.warm_up(["adpc-pso", "dpc-pso", "greedy", "bp", "tests.x:y"]) == ["hook_a", "hook_b"]
+    assert registry.warm_up(["adpc-ga", "bp"]) == []  # already done in this process
+    assert calls == ["a", "b"]
+
+    methods["bp"] = dataclasses.replace(methods["bp"], warm_up=broken)
+    monkeypatch.setattr(registry, "_WARMED", set())
     assert registry.warm_up(["bp"]) == []  # the job itself will report the problem
 
 

@@ -15,7 +15,7 @@ from sarcover.benchmarks.registry import run_method
 from sarcover.formulations.bp import solve_bp
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.io import load_instance
-from sarcover.formulations.plan import Status
+from sarcover.formulations.result import Status
 from sarcover.formulations.verify import route_energy, verify
 
 TOP_DIR = Path(__file__).resolve().parent.parent / "benchmarks" / "instances" / "top"
@@ -63,11 +63,11 @@ def test_line_instance_by_hand():
     """Two vehicles on a hand-checked instance: (1,0),(2,0) on one trip, (0,3) on the other: 8."""
     inst = TOPInstance(coords=[[1, 0], [2, 0], [0, 3]], prizes=[1, 2, 5], start=[0, 0], end=[0, 0],
                        budget=6.0, n_vehicles=2)
-    res, rep = run_method("bp", inst, time_limit=30)
+    res = run_method("bp", inst, time_limit=30)
     assert res.status == Status.OPTIMAL and res.objective == 8.0 and res.bound == 8.0
     one = TOPInstance(coords=[[1, 0], [2, 0], [0, 3]], prizes=[1, 2, 5], start=[0, 0], end=[0, 0],
                       budget=4.5, n_vehicles=1)
-    res, rep = run_method("bp", one, time_limit=30)
+    res = run_method("bp", one, time_limit=30)
     assert res.status == Status.OPTIMAL and res.objective == 3.0
 
 
@@ -77,7 +77,7 @@ def test_matches_brute_force(seed, groups):
     """The proven optimum equals exhaustive enumeration on tiny random instances, with and without groups."""
     inst = random_tiny(seed, groups=groups)
     best = brute_force(inst)
-    res, rep = run_method("bp", inst, time_limit=30)
+    res = run_method("bp", inst, time_limit=30)
     if best is None:
         assert res.status == Status.INFEASIBLE
     else:
@@ -90,7 +90,7 @@ def test_start_differs_from_end(seed):
     """Open routes from start to a different end: optimum equals enumeration."""
     inst = random_tiny(seed, groups=False, same_depot=False)
     best = brute_force(inst)
-    res, rep = run_method("bp", inst, time_limit=30)
+    res = run_method("bp", inst, time_limit=30)
     assert res.status == Status.OPTIMAL and res.objective == pytest.approx(best)
 
 
@@ -98,7 +98,7 @@ def test_infeasible_groups_proven():
     """Two groups on opposite sides, each reachable alone but not both with one vehicle: infeasible."""
     inst = TOPInstance(coords=[[5, 0], [-5, 0], [0, 1]], prizes=[1, 1, 3], start=[0, 0], end=[0, 0],
                        budget=10.5, n_vehicles=1, groups=((0,), (1,)))
-    res, rep = run_method("bp", inst, time_limit=30)
+    res = run_method("bp", inst, time_limit=30)
     assert res.status == Status.INFEASIBLE and res.plan is None
 
 
@@ -106,7 +106,7 @@ def test_groups_force_lower_prize():
     """A group on a cheap node forces the vehicle away from the big prize (hand-checked: 1)."""
     inst = TOPInstance(coords=[[3, 0], [-3, 0]], prizes=[1, 10], start=[0, 0], end=[0, 0],
                        budget=6.5, n_vehicles=1, groups=((0,),))
-    res, rep = run_method("bp", inst, time_limit=30)
+    res = run_method("bp", inst, time_limit=30)
     assert res.status == Status.OPTIMAL and res.objective == 1.0 and res.plan.visited == [0]
 
 
@@ -124,7 +124,7 @@ FAST_TOP = ["p1.2.j", "p1.3.n", "p1.4.r", "p2.2.k", "p2.3.g", "p2.4.k", "p3.2.e"
 def test_top_benchmark_optimum(name):
     """On a fast TOP subset, bp proves exactly the published optimum."""
     inst = load_instance(TOP_DIR / f"{name}.txt")
-    res, rep = run_method("bp", inst, time_limit=60)
+    res = run_method("bp", inst, time_limit=60)
     assert res.status == Status.OPTIMAL, res.reason
     assert res.objective == OPTIMAL[name] and res.bound == OPTIMAL[name]
 
@@ -135,7 +135,7 @@ def test_stopped_run_bound_is_valid(name):
     inst = load_instance(TOP_DIR / f"{name}.txt") if (TOP_DIR / f"{name}.txt").exists() else None
     if inst is None:
         pytest.skip(f"{name} not in the public part")
-    res, rep = run_method("bp", inst, time_limit=2)
+    res = run_method("bp", inst, time_limit=2)
     assert res.status in (Status.OPTIMAL, Status.TIME_LIMIT)
     assert res.bound is not None and res.bound >= OPTIMAL[name] - 1e-6
 
@@ -145,7 +145,7 @@ def test_stopped_run_bound_is_valid(name):
 def test_top_sets_1_to_3_all(name):
     """Every TOP instance of sets 1-3: the published optimum, proven within 60 s."""
     inst = load_instance(TOP_DIR / f"{name}.txt")
-    res, rep = run_method("bp", inst, time_limit=60)
+    res = run_method("bp", inst, time_limit=60)
     assert res.bound is None or res.bound >= OPTIMAL[name] - 1e-6
     assert res.status == Status.OPTIMAL, res.reason
     assert res.objective == OPTIMAL[name]
@@ -166,7 +166,7 @@ def test_small_sar_matches_brute_force(e_max):
     inst = tiny_sar(e_max)
     best = brute_force(inst)
     assert best is not None and best < inst.total_prize  # feasible, and the budget binds
-    res, rep = run_method("bp", inst, time_limit=30)
+    res = run_method("bp", inst, time_limit=30)
     assert res.status == Status.OPTIMAL and res.objective == best
 
 
@@ -176,11 +176,11 @@ def test_sar_infeasible_when_targets_do_not_fit():
 
     inst = tiny_sar(4500.0)
     assert precheck(inst) is None and brute_force(inst) is None
-    res, rep = run_method("bp", inst, time_limit=30)
+    res = run_method("bp", inst, time_limit=30)
     assert res.status == Status.INFEASIBLE
 
 
-# -- the pieces added for the M = 20 SAR instances (issue 6) -----------------------------------
+# -- the pieces added for the M = 20 SAR instances -----------------------------------
 
 def _tiny_pricing(seed: int, n_nodes: int = 7):
     """A random pricing problem: Euclidean arcs with an image cost, reduced prizes of both signs."""
@@ -492,9 +492,9 @@ def test_registered_bp_starts_from_greedy():
     from sarcover.formulations.instance import to_top
 
     inst = to_top(generate(20, 3, 5, 11))
-    g, _ = run_method("greedy", inst)
-    r, rep = run_method("bp", inst, time_limit=0.5)
-    assert g.status == Status.FEASIBLE and r.plan is not None and rep.valid
+    g = run_method("greedy", inst)
+    r = run_method("bp", inst, time_limit=0.5)
+    assert g.status == Status.FEASIBLE and r.plan is not None and r.report.valid
     assert r.objective >= g.objective and r.bound >= r.objective
     assert r.info["warm_start_prize"] == g.objective
     # stopped with a gap, some node is left open; a proven run leaves none
@@ -563,8 +563,8 @@ def test_a_bad_primal_costs_nothing_but_its_time(kind):
 def test_registered_bp_runs_pyvrp_as_its_primal():
     """The registered `bp` hands PyVRP to the search: on an instance the root leaves open its
     plan is verified and counted (p1.2.l)."""
-    r, rep = run_method("bp", _top("p1.2.l"), time_limit=60)
-    assert rep.valid and r.status == Status.OPTIMAL
+    r = run_method("bp", _top("p1.2.l"), time_limit=60)
+    assert r.report.valid and r.status == Status.OPTIMAL
     assert r.info["primal_prize"] is not None and r.info["primal_prize"] <= r.objective + 1e-9
     assert r.info["primal_error"] is None
 
@@ -807,21 +807,22 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, thre
     """The registered bp spends a moment on greedy before solve_bp; whether cuts are on, and how
     open their gate is, follow the user's time limit (at CUTS_FROM_S: on; at OPEN_CUTS_FROM_S:
     open), not the slightly smaller one left for solve_bp."""
+    import sarcover.formulations.bp as bp_package
     import sarcover.formulations.bp.branch_price as branch_price
-    import sarcover.heuristics.bp_warm as warm
+    from sarcover.benchmarks.registry import METHODS
     from sarcover.formulations.bp.branch_price import (CUTS_FROM_S, OPEN_CUTS_FROM_S, default_cut_gap,
                                               default_cut_rounds)
-    from sarcover.formulations.plan import Result
+    from sarcover.formulations.result import Result, Termination
 
     limit = getattr(branch_price, threshold) + offset
     seen = {}
 
     def fake_solve_bp(instance, **kw):
         seen.update(kw)
-        return Result("bp", Status.TIME_LIMIT, runtime_s=0.0, reason="stub")
+        return Result("bp", Termination.TIME_LIMIT, runtime_s=0.0, reason="stub")
 
-    monkeypatch.setattr(warm, "solve_bp", fake_solve_bp)
-    warm.bp(random_tiny(0, groups=False), time_limit=limit)
+    monkeypatch.setattr(bp_package, "solve_bp", fake_solve_bp)
+    METHODS["bp"].run(random_tiny(0, groups=False), time_limit=limit)
     assert seen["time_limit"] < limit
     assert seen["cut_rounds"] == default_cut_rounds(limit) == (6 if limit >= CUTS_FROM_S else 0)
     assert seen["cut_gap"] == default_cut_gap(limit) == (1.0 if limit >= OPEN_CUTS_FROM_S else 0.5)

@@ -11,7 +11,8 @@ from sarcover.benchmarks.registry import run_method
 from sarcover.formulations.cpsat import CpsatInputError, prize_scale, solve_cpsat
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.io import read_top
-from sarcover.formulations.plan import Plan, Status
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.result import Status
 from sarcover.formulations.verify import verify
 from sarcover.heuristics.greedy import greedy
 
@@ -28,9 +29,9 @@ def top(coords, prizes, budget, n=1, start=(0.0, 0.0), end=(0.0, 0.0), groups=()
 
 def solve(inst, **kw):
     """Run through the registry (verifier, bound check) and return (result, report)."""
-    res, rep = run_method("cpsat", inst, time_limit=kw.pop("time_limit", 20.0))
+    res = run_method("cpsat", inst, time_limit=kw.pop("time_limit", 20.0))
     assert res.status != Status.ERROR, res.reason
-    return res, rep
+    return res, res.report
 
 
 LINE = [[1.0, 0.0], [2.0, 0.0], [3.0, 0.0]]
@@ -126,7 +127,7 @@ def test_models_agree_and_hint_is_used(model):
     inst = read_top(TOP_DIR / "p2.3.g.txt")
     hint = greedy(inst).plan
     for h in (None, hint):
-        res = solve_cpsat(inst, time_limit=20, model=model, hint=h)
+        res = solve_cpsat(inst, time_limit=20, model=model, warm_start=h)
         assert res.status == Status.OPTIMAL
         assert verify(inst, res.plan).prize == PUBLISHED["p2.3.g"]
 
@@ -146,7 +147,7 @@ def test_time_limit_returns_incumbent_and_valid_bound():
 
 def _check_top(name: str, time_limit: float):
     inst = read_top(TOP_DIR / f"{name}.txt")
-    res, rep = run_method("cpsat", inst, time_limit=time_limit)
+    res = run_method("cpsat", inst, time_limit=time_limit)
     assert res.status != Status.ERROR, res.reason
     if res.status == Status.OPTIMAL:
         assert res.objective == PUBLISHED[name]

@@ -11,7 +11,7 @@ import pytest
 
 from sarcover.benchmarks.regression import load_spec, random_cases
 from sarcover.benchmarks.registry import METHODS, run_method
-from sarcover.formulations.plan import Status
+from sarcover.formulations.result import Status
 
 EXACT = ("milp", "cpsat")
 TOL = 1e-9
@@ -33,7 +33,7 @@ def crosscheck(spec: str, time_limit: float, heuristics: list[str], heuristic_li
     inst = load_spec(spec)
     res = {}
     for name in EXACT:
-        r, _ = run_method(name, inst, time_limit=time_limit)
+        r = run_method(name, inst, time_limit=time_limit)
         assert r.status != Status.ERROR, f"{spec} {name}: {r.reason}"
         res[name] = r
     a, b = res["milp"], res["cpsat"]
@@ -50,7 +50,7 @@ def crosscheck(spec: str, time_limit: float, heuristics: list[str], heuristic_li
     bounds = [r.bound for r in res.values() if r.bound is not None]
     cap = min(bounds) if bounds else float("inf")
     for h in heuristics:
-        r, _ = run_method(h, inst, time_limit=heuristic_limit)
+        r = run_method(h, inst, time_limit=heuristic_limit)
         assert r.status != Status.ERROR, f"{spec} {h}: {r.reason}"
         if infeasible:
             assert r.plan is None, f"{spec}: {h} has a plan on a proven infeasible instance"

@@ -6,13 +6,13 @@ import pytest
 from sarcover.benchmarks.registry import run_method
 from sarcover.formulations.generate import generate
 from sarcover.formulations.instance import to_top
-from sarcover.formulations.plan import Status
+from sarcover.formulations.result import Status
 
 
 def test_greedy_takes_everything_when_budget_allows(line_instance):
     """Budget 6 on the line instance: all three nodes on one route."""
-    res, rep = run_method("greedy", line_instance)
-    assert res.status == Status.FEASIBLE and rep.valid and res.objective == 6.0
+    res = run_method("greedy", line_instance)
+    assert res.status == Status.FEASIBLE and res.report.valid and res.objective == 6.0
 
 
 @pytest.mark.parametrize("seed", range(300))
@@ -22,11 +22,11 @@ def test_greedy_plans_always_verified(seed):
     m, k, n = int(rng.integers(2, 15)), int(rng.integers(1, 5)), int(rng.integers(1, 5))
     e_max = float(rng.choice([2000, 3000, 4500, 6000, 9000]))
     inst = to_top(generate(m, k, n, seed, e_max=e_max))
-    res, rep = run_method("greedy", inst)
+    res = run_method("greedy", inst)
     assert res.status in (Status.FEASIBLE, Status.NO_PLAN, Status.INFEASIBLE), res.reason
     if res.status == Status.FEASIBLE:
-        assert rep.valid and rep.groups_covered == m
-        assert res.objective == rep.covered
+        assert res.report.valid and res.report.groups_covered == m
+        assert res.objective == res.report.covered
     else:
         assert res.plan is None and res.reason
 
@@ -40,6 +40,6 @@ def test_greedy_rules_by_hand():
 
     inst = TOPInstance(coords=np.array([[1.0, 0.0], [2.0, 0.0], [5.0, 0.0]]), prizes=np.array([1.0, 3.0, 1.0]),
                        start=np.zeros(2), end=np.zeros(2), budget=10.0, n_vehicles=1, groups=[[0, 1], [2]])
-    res, rep = run_method("greedy", inst)
-    assert res.status == Status.FEASIBLE and rep.valid
+    res = run_method("greedy", inst)
+    assert res.status == Status.FEASIBLE and res.report.valid
     assert res.plan.routes == ((0, 1, 2),) and res.objective == 5.0

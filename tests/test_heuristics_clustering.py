@@ -1,4 +1,4 @@
-"""DPC and ADPC clustering (issue 4): known centres, the scikit-learn contract, ADPC's size bias."""
+"""DPC and ADPC clustering: known centres, the scikit-learn contract, ADPC's size bias."""
 
 from __future__ import annotations
 

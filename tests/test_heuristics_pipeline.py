@@ -1,4 +1,4 @@
-"""The cluster-then-route methods (issue 4): verified plans, honest statuses, reproducibility."""
+"""The cluster-then-route methods: verified plans, honest statuses, reproducibility."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 from sarcover.benchmarks.registry import METHODS, run_method
 from sarcover.formulations.generate import generate
 from sarcover.formulations.instance import TOPInstance, to_top
-from sarcover.formulations.plan import Status
+from sarcover.formulations.result import Status
 from sarcover.formulations.verify import verify
 
 PIPELINES = ["adpc-pso", "dpc-pso", "kmeans-pso", "adpc-ga", "adpc-aco"]
@@ -48,11 +48,11 @@ def _check(name: str, seeds) -> dict:
     counts: dict[str, int] = {}
     for seed in seeds:
         inst = random_instance(seed)
-        result, report = run_method(name, inst, seed=seed, time_limit=30.0)
+        result = run_method(name, inst, seed=seed, time_limit=30.0)
         assert result.status != Status.ERROR, (seed, result.reason)
         assert result.status in (Status.FEASIBLE, Status.NO_PLAN, Status.INFEASIBLE), (seed, result.status)
         if result.status == Status.FEASIBLE:
-            assert report is not None and report.valid
+            assert result.report is not None and result.report.valid
             assert len(result.plan.routes) == inst.n_vehicles
         else:
             assert result.plan is None and result.reason
@@ -84,8 +84,8 @@ def test_verified_plans_many(name):
 def test_same_seed_same_plan(name):
     """Two runs with one seed give the same plan; the registry lists the method as a heuristic."""
     inst = to_top(generate(12, 3, 3, seed=5))
-    a, _ = run_method(name, inst, seed=3)
-    b, _ = run_method(name, inst, seed=3)
+    a = run_method(name, inst, seed=3)
+    b = run_method(name, inst, seed=3)
     assert a.status == Status.FEASIBLE and a.plan == b.plan
     assert not METHODS[name].exact and a.bound is None
 
@@ -94,15 +94,15 @@ def test_same_seed_same_plan(name):
 def test_paper_instance_coverage_at_least_greedy_groups(name):
     """On a paper-size instance every target is covered and coverage is between 0 and 1."""
     inst = to_top(generate(20, 3, 5, seed=0))
-    result, report = run_method(name, inst, seed=0)
+    result = run_method(name, inst, seed=0)
     assert result.status == Status.FEASIBLE
-    assert report.groups_covered == 20 and 20 <= report.covered < 60
+    assert result.report.groups_covered == 20 and 20 <= result.report.covered < 60
 
 
 def test_unreachable_group_is_infeasible_and_crowded_budget_is_no_plan():
     """A target out of reach is INFEASIBLE (precheck); too many targets for one tiny route is NO_PLAN."""
     far = to_top(generate(3, 3, 2, seed=1, e_max=200.0))
-    result, _ = run_method("adpc-pso", far)
+    result = run_method("adpc-pso", far)
     assert result.status == Status.INFEASIBLE
     # four groups on the corners of a square, each alone within budget, two vehicles: at most
     # two groups fit, so no plan covers all four
@@ -110,7 +110,7 @@ def test_unreachable_group_is_infeasible_and_crowded_budget_is_no_plan():
     inst = TOPInstance(coords=coords, prizes=np.ones(4), start=np.zeros(2), end=np.zeros(2),
                        budget=21.0, n_vehicles=2, groups=((0,), (1,), (2,), (3,)))
     for name in PIPELINES:
-        result, _ = run_method(name, inst)
+        result = run_method(name, inst)
         assert result.status == Status.NO_PLAN and "could not fit" in result.reason
 
 
@@ -120,8 +120,8 @@ def test_general_top_with_distinct_end():
     inst = TOPInstance(coords=rng.uniform(0, 50, (25, 2)), prizes=rng.integers(1, 5, 25).astype(float),
                        start=np.zeros(2), end=np.array([50.0, 50.0]), budget=110.0, n_vehicles=3)
     for name in PIPELINES:
-        result, report = run_method(name, inst)
-        assert result.status == Status.FEASIBLE and report.valid and report.prize > 0
+        result = run_method(name, inst)
+        assert result.status == Status.FEASIBLE and result.report.valid and result.report.prize > 0
         assert verify(inst, result.plan).valid
 
 
@@ -129,6 +129,6 @@ def test_general_top_with_distinct_end():
 def test_expired_time_limit_still_gives_a_verified_plan(name):
     """A time limit that expires at once stops the routers early; the repaired plan still verifies."""
     inst = to_top(generate(20, 3, 5, seed=4))
-    result, report = run_method(name, inst, seed=0, time_limit=1e-9)
-    assert result.status == Status.FEASIBLE and report.valid
+    result = run_method(name, inst, seed=0, time_limit=1e-9)
+    assert result.status == Status.FEASIBLE and result.report.valid
     assert result.info["stopped_by_time"] is True

@@ -1,4 +1,4 @@
-"""PSO, GA and ACO tour routers and the shared tour helpers (issue 4)."""
+"""PSO, GA and ACO tour routers and the shared tour helpers."""
 
 from __future__ import annotations
 

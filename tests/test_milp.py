@@ -14,7 +14,8 @@ from sarcover.benchmarks.registry import run_method
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.io import read_top
 from sarcover.formulations.milp import build_milp, solve_milp
-from sarcover.formulations.plan import Plan, Status
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.result import Status
 from sarcover.formulations.preprocess import floor_to_lattice, incompatible_cliques, prize_lattice, prune_arcs
 from sarcover.formulations.verify import route_energy
 
@@ -28,9 +29,9 @@ def top(coords, prizes, budget, n=1, start=(0.0, 0.0), end=None, **kw) -> TOPIns
 
 
 def solve(inst, time_limit=30.0):
-    result, report = run_method("milp", inst, time_limit=time_limit)
+    result = run_method("milp", inst, time_limit=time_limit)
     assert result.status != Status.ERROR, result.reason
-    return result, report
+    return result, result.report
 
 
 def brute_force(inst: TOPInstance) -> float | None:

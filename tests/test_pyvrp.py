@@ -6,18 +6,19 @@ import pytest
 from sarcover.benchmarks.registry import run_method
 from sarcover.formulations.generate import generate
 from sarcover.formulations.instance import TOPInstance, to_top
-from sarcover.formulations.plan import Plan, Status
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.result import Status
 from sarcover.formulations.scaling import integer_prizes, scaled_costs
 from sarcover.formulations.verify import route_energy, verify
-from sarcover.heuristics.pyvrp_method import cover_groups
+from sarcover.heuristics.pyvrp_ils import cover_groups
 
 
 @pytest.mark.parametrize("seed", [0, 7])
 def test_same_seed_same_plan(seed):
     """Stopped by iterations, PyVRP returns the same plan for the same seed."""
     inst = to_top(generate(8, 2, 2, seed, e_max=6000.0))
-    a, _ = run_method("pyvrp", inst, seed=seed, time_limit=30.0)
-    b, _ = run_method("pyvrp", inst, seed=seed, time_limit=30.0)
+    a = run_method("pyvrp", inst, seed=seed, time_limit=30.0)
+    b = run_method("pyvrp", inst, seed=seed, time_limit=30.0)
     assert all(a.info[p]["stopped_by"] == "iterations" for p in ("pass1", "pass2"))
     assert a.status == Status.FEASIBLE and a.plan == b.plan
 
@@ -58,5 +59,5 @@ def test_infeasible_cover_is_no_plan():
     """Two groups on opposite sides with one vehicle: both passes fail, status NO_PLAN with a reason."""
     inst = TOPInstance(coords=np.array([[0, 4.0], [0, -4.0]]), prizes=np.ones(2), start=np.zeros(2),
                        end=np.zeros(2), budget=10.0, n_vehicles=1, groups=((0,), (1,)))
-    res, _ = run_method("pyvrp", inst, time_limit=2.0)
+    res = run_method("pyvrp", inst, time_limit=2.0)
     assert res.status == Status.NO_PLAN and res.plan is None and res.reason

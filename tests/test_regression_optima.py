@@ -4,7 +4,7 @@ import pytest
 
 from sarcover.benchmarks.regression import TABLE, load_spec, read_table
 from sarcover.benchmarks.registry import METHODS, run_method
-from sarcover.formulations.plan import Status
+from sarcover.formulations.result import Status
 
 ROWS = read_table(TABLE)
 # Default run: the rows both solvers confirmed fastest (at most 1 s each when the table was made).
@@ -14,7 +14,7 @@ FAST = [r for r in ROWS if float(r["milp_s"]) <= 1.0 and float(r["cpsat_s"]) <= 
 def _reproduce(row: dict, method: str, time_limit: float):
     if method not in METHODS:
         pytest.skip(f"method {method!r} is not registered")
-    res, _ = run_method(method, load_spec(row["spec"]), time_limit=time_limit)
+    res = run_method(method, load_spec(row["spec"]), time_limit=time_limit)
     if row["status"] == "infeasible":
         assert res.status == Status.INFEASIBLE, f"{row['spec']}: {res.status} {res.reason}"
     else:

@@ -1,10 +1,11 @@
-"""The reference report (issue 7) end to end on a tiny run of the paper suites."""
+"""The reference report end to end on a tiny run of the paper suites."""
 
 from __future__ import annotations
 
 import pytest
 
 from sarcover.benchmarks.harness import run_suite
+from sarcover.benchmarks.reproduce import SUITES
 from sarcover.benchmarks.suite import load_suite
 from sarcover.reports.reference import write_reference
 
@@ -19,7 +20,7 @@ def tiny_root(tmp_path_factory):
 
 def test_reference_report_written_with_claims(tiny_root, tmp_path):
     """Figures, tables and every claim section come out of one run of paper-n and paper-k."""
-    readme = write_reference(tiny_root, tmp_path / "out")
+    readme = write_reference(tiny_root, tmp_path / "out", suites=SUITES)
     text = readme.read_text()
     for heading in ("ADPC-PSO has the best coverage", "Coverage rises with N and falls with K",
                     "ADPC-PSO degrades least", "Runtime ordering", "paper Table I", "Example routes"):
@@ -32,7 +33,7 @@ def test_reference_report_counts_runs(tiny_root, tmp_path):
     """The coverage tables hold one row per method and setting with the stored number of runs."""
     import pandas as pd
 
-    write_reference(tiny_root, tmp_path / "out")
+    write_reference(tiny_root, tmp_path / "out", suites=SUITES)
     tab = pd.read_csv(tmp_path / "out" / "coverage_vs_N.csv")
     assert set(tab["N"]) == {2, 3, 4, 5, 6}
     assert (tab["runs"] == 1).all() and tab["mean"].between(0, 1).all()
@@ -72,7 +73,7 @@ def test_long_bp_rows_join_the_paper_scale_gaps(tmp_path):
         f = tmp_path / f"{name}.toml"
         f.write_text(f'name = "{name}"\n' + common.format(m=methods))
         run_suite(load_suite(str(f)), root / name, workers=1, progress=False)
-    text = write_reference(root, tmp_path / "out").read_text()
+    text = write_reference(root, tmp_path / "out", suites=SUITES).read_text()
     assert "paper-gaps-long" in text and "bp-300s" in text
     runs = pd.read_csv(tmp_path / "out" / "runs_paper_gaps.csv")
     assert set(runs["method"]) == {"greedy", "bp", "bp-300s"}

@@ -16,7 +16,7 @@ import pytest
 from sarcover.formulations.bp import solve_bp
 from sarcover.formulations.bp.pricing import cheapest_return, full_ng, nearest_ng, price
 from sarcover.formulations.io import read_top
-from sarcover.formulations.plan import Status
+from sarcover.formulations.result import Status
 
 TOP_DIR = Path(__file__).resolve().parent / "instances" / "top"
 

@@ -62,7 +62,7 @@ def solve(method: str, inst: TOPInstance, threads: int, time_limit: float = TIME
     if warm is not None and not verify(inst, warm).valid:
         warm = None
     if method == "cpsat":
-        return solve_cpsat(inst, time_limit=time_limit, threads=threads, hint=warm)
+        return solve_cpsat(inst, time_limit=time_limit, threads=threads, warm_start=warm)
     # HiGHS keeps one global thread pool per process; a run with another thread count fails
     # ("HiGHS stopped: unknown") unless the pool is reset first.
     highspy.Highs.resetGlobalScheduler(True)

@@ -6,7 +6,7 @@ Run on one core, CPU time (the machine is shared, so wall time is noisy)::
         --benchmark-timer time.process_time --benchmark-columns median,mean,min,rounds
 
 Each run is a whole method call at the paper's size M=20, K=3, N=5 (``generate(20, 3, 5, seed)``),
-cycling over 10 instances and seeds. Targets (issue 4): ``adpc-pso`` ≤ 20 ms a run, ``adpc-aco``
+cycling over 10 instances and seeds. Targets: ``adpc-pso`` ≤ 20 ms a run, ``adpc-aco``
 ≤ 60 ms, so that the paper's experiment (2 figures × 5 settings × 5 methods × 1000 runs) fits in
 10 minutes on 2 cores. The clustering step alone is timed too (the paper's Table I lists it).
 """
@@ -22,7 +22,7 @@ import pytest
 
 from sarcover.formulations.generate import generate
 from sarcover.formulations.instance import to_top
-from sarcover.formulations.plan import Status
+from sarcover.formulations.result import Status
 from sarcover.heuristics.pipeline import make_clusterer
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")  # scikit-learn KMeans: one core like the rest

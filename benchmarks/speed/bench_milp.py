@@ -13,7 +13,7 @@ import pytest
 
 from sarcover.formulations.io import read_top
 from sarcover.formulations.milp import build_milp, solve_milp
-from sarcover.formulations.plan import Status
+from sarcover.formulations.result import Status
 from sarcover.formulations.preprocess import prune_arcs
 
 TOP_DIR = Path(__file__).resolve().parent / "instances" / "top"

@@ -16,7 +16,7 @@ from sarcover.benchmarks.registry import run_method
 from sarcover.formulations.generate import generate
 from sarcover.formulations.instance import to_top
 from sarcover.formulations.io import read_top
-from sarcover.formulations.plan import Status
+from sarcover.formulations.result import Status
 
 TOP_DIR = Path(__file__).resolve().parent / "instances" / "top"
 
@@ -25,7 +25,7 @@ TOP_DIR = Path(__file__).resolve().parent / "instances" / "top"
 def test_bench_peer_sar_m20_k3_n5(benchmark, method):
     """One run on the paper preset at M=20, K=3, N=5 (seed 0)."""
     inst = to_top(generate(20, 3, 5, 0))
-    result, _ = benchmark.pedantic(lambda: run_method(method, inst, seed=0, time_limit=10.0), rounds=3, iterations=1)
+    result = benchmark.pedantic(lambda: run_method(method, inst, seed=0, time_limit=10.0), rounds=3, iterations=1)
     assert result.status == Status.FEASIBLE
 
 
@@ -33,5 +33,5 @@ def test_bench_peer_sar_m20_k3_n5(benchmark, method):
 def test_bench_peer_top_p3_4_s(benchmark, method):
     """One run on TOP p3.4.s (31 customers, 4 vehicles)."""
     inst = read_top(TOP_DIR / "p3.4.s.txt")
-    result, _ = benchmark.pedantic(lambda: run_method(method, inst, seed=0, time_limit=10.0), rounds=3, iterations=1)
+    result = benchmark.pedantic(lambda: run_method(method, inst, seed=0, time_limit=10.0), rounds=3, iterations=1)
     assert result.status == Status.FEASIBLE

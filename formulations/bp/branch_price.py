@@ -143,7 +143,8 @@ from sarcover.formulations.bp.master import MAX_CUTS, Master
 from sarcover.formulations.bp.pricing import (add_to_ng, arc_bounds, cheapest_return, full_ng,
                                      label_arc_bounds, nearest_ng, price, warm_up)
 from sarcover.formulations.instance import TOPInstance, precheck
-from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.result import Result, Termination
 from sarcover.formulations.verify import verify
 
 TOL = 1e-6
@@ -871,7 +872,7 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
     t0 = time.perf_counter()
     reason = precheck(instance)
     if reason is not None:
-        return Result("bp", Status.INFEASIBLE, reason=reason, runtime_s=time.perf_counter() - t0)
+        return Result("bp", Termination.INFEASIBLE, reason=reason, runtime_s=time.perf_counter() - t0)
     bp = BranchAndPrice(instance, time_limit=time_limit, ng_size=ng_size,
                         initial_routes=initial_routes, bidirectional=bidirectional,
                         ng_columns=ng_columns, ng_cap=ng_cap, grow_share=grow_share,
@@ -901,14 +902,14 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
     plan = None if bp.incumbent is None else Plan.of([[p - 1 for p in r] for r in bp.incumbent])
     if plan is None:
         if proven:
-            return Result("bp", Status.INFEASIBLE, bound=None, runtime_s=runtime, info=info,
+            return Result("bp", Termination.INFEASIBLE, bound=None, runtime_s=runtime, info=info,
                           reason="branch-and-price proved that no plan covers every group")
         b = bound if math.isfinite(bound) else None
-        return Result("bp", Status.TIME_LIMIT, bound=b, runtime_s=runtime, info=info,
+        return Result("bp", Termination.TIME_LIMIT, bound=b, runtime_s=runtime, info=info,
                       reason="time limit before a plan covering every group was found")
     if proven:
-        return Result("bp", Status.OPTIMAL, plan=plan, bound=bp.incumbent_value, runtime_s=runtime,
+        return Result("bp", Termination.OPTIMAL, plan=plan, bound=bp.incumbent_value, runtime_s=runtime,
                       info=info)
     b = bound if math.isfinite(bound) else None
-    return Result("bp", Status.TIME_LIMIT, plan=plan, bound=b, runtime_s=runtime, info=info,
+    return Result("bp", Termination.TIME_LIMIT, plan=plan, bound=b, runtime_s=runtime, info=info,
                   reason="time limit")

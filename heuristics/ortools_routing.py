@@ -1,7 +1,12 @@
-"""The OR-Tools routing solver on the TOP form (a heuristic: no bound).
+"""`routing`: the OR-Tools routing solver on the TOP form, guided local search (a heuristic: no bound).
 
-The registered method `routing` (:mod:`sarcover.heuristics.routing_method`) calls :func:`solve_routing`,
-falling back to a greedy warm start when the cold search leaves a group uncovered.
+:func:`solve_routing` is one search on the model below; :func:`routing` is the registered method:
+a cold search gets ``COLD_SHARE`` of the time; if its best plan leaves a group uncovered, or
+collects less than the `greedy` plan (which covers every group whenever greedy succeeds), a
+second search starts from greedy's plan with the remaining time, and the better of the two plans
+is returned. On tight SAR budgets the cold search sometimes never finds a covering plan, and with
+little CPU it can end far below greedy. When the cold plan is at least greedy's, the warm search
+is skipped: it gave worse plans than a cold one (``docs/heuristics.md``).
 
 Model (the sequence of the OR-Tools samples: build, set limits and strategy, solve, extract):
 
@@ -20,10 +25,9 @@ Model (the sequence of the OR-Tools samples: build, set limits and strategy, sol
   neither) keeps prizes exact and forbids double visits (a node may belong to several
   disjunctions in OR-Tools), and per group the disjunction {copies of its nodes} (at most one
   active) carries a penalty above all prizes and travel together, so covering every group
-  comes first. A plan that still leaves a group uncovered comes back as NO_PLAN. Tried and
-  dropped on M=20, K=3, N=5 (seeds 0-2): the side constraint ``sum(ActiveVar) >= 1`` and a
-  mandatory (negative-penalty) cover disjunction both made every first-solution strategy
-  tried fail (path cheapest arc, savings, parallel/local/sequential cheapest insertion).
+  comes first. A plan that still leaves a group uncovered comes back without a plan. The side
+  constraint ``sum(ActiveVar) >= 1`` and a mandatory cover disjunction were tried: every
+  first-solution strategy then failed (``docs/heuristics.md``).
 - search: local cheapest insertion (or the given warm start), then guided local search,
   single-threaded. It stops at ``time_limit`` or after ``solution_limit`` solutions,
   whichever comes first. A run stopped by the solution limit is deterministic; one stopped by
@@ -38,9 +42,11 @@ import numpy as np
 from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 
 from sarcover.formulations.instance import TOPInstance
-from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.result import Result, Termination
 from sarcover.formulations.scaling import integer_prizes, scaled_costs
 from sarcover.formulations.verify import verify
+from sarcover.heuristics.greedy import greedy
 
 DEFAULT_TIME_CAP = 10.0  # seconds, when no time limit is given
 SOLUTION_LIMIT = 1000  # local-search solutions; the reproducible stop (~1-10 s at 60 nodes)
@@ -76,9 +82,9 @@ def solve_routing(
     k, n_veh = len(nodes), instance.n_vehicles
     if k == 0:
         if instance.groups:
-            return Result("routing", Status.NO_PLAN, reason="no group node is reachable",
+            return Result("routing", Termination.COMPLETED, reason="no group node is reachable",
                           runtime_s=time.perf_counter() - t0)
-        return Result("routing", Status.FEASIBLE, plan=Plan.of([[] for _ in range(n_veh)]),
+        return Result("routing", Termination.COMPLETED, plan=Plan.of([[] for _ in range(n_veh)]),
                       runtime_s=time.perf_counter() - t0, info={"stopped_by": "trivial"})
 
     # Groups: every group node v gets a "cover copy" at the same place. Disjunction {v, copy}
@@ -95,7 +101,7 @@ def solve_routing(
                 copies.append(int(v))
                 locs.append(k + len(copies))
         if not locs:
-            return Result("routing", Status.NO_PLAN, reason=f"group {gi} has no reachable node",
+            return Result("routing", Termination.COMPLETED, reason=f"group {gi} has no reachable node",
                           runtime_s=time.perf_counter() - t0)
         group_locs.append(locs)
     model_nodes = np.concatenate([nodes, np.asarray(copies, dtype=int)]).astype(int)  # model loc - 1 -> node id
@@ -164,7 +170,7 @@ def solve_routing(
         what = "target" if instance.kind == "sar" else "group"
         reason = (f"OR-Tools routing found no plan covering every {what} in {solve_s:.3g} s"
                   if instance.groups else "OR-Tools routing found no solution")
-        return Result("routing", Status.NO_PLAN, reason=reason, runtime_s=time.perf_counter() - t0, info=info)
+        return Result("routing", Termination.COMPLETED, reason=reason, runtime_s=time.perf_counter() - t0, info=info)
 
     routes = []
     for veh in range(n_veh):
@@ -180,12 +186,43 @@ def solve_routing(
     if uncovered:
         what = "target" if instance.kind == "sar" else "group"
         info["uncovered"] = uncovered
-        return Result("routing", Status.NO_PLAN, runtime_s=time.perf_counter() - t0, info=info,
+        return Result("routing", Termination.COMPLETED, runtime_s=time.perf_counter() - t0, info=info,
                       reason=f"OR-Tools routing left {len(uncovered)} {what}(s) uncovered, e.g. {what} {uncovered[0]}")
     info["stopped_by"] = "time" if solve_s >= remaining * 0.98 else "solution_limit"
     info["objective_int"] = int(solution.ObjectiveValue())
     report = verify(instance, plan)  # the integer model rounds up; this must never fail
     if not report.valid:
-        return Result("routing", Status.ERROR, plan=plan, runtime_s=time.perf_counter() - t0,
+        return Result("routing", Termination.ERROR, plan=plan, runtime_s=time.perf_counter() - t0,
                       reason="routing plan failed verification: " + "; ".join(report.violations[:3]), info=info)
-    return Result("routing", Status.FEASIBLE, plan=plan, runtime_s=time.perf_counter() - t0, info=info)
+    return Result("routing", Termination.COMPLETED, plan=plan, runtime_s=time.perf_counter() - t0, info=info)
+
+
+TIME_CAP = 10.0  # seconds: the method runs at most min(time_limit, TIME_CAP)
+COLD_SHARE = 0.6
+
+
+def _prize(instance: TOPInstance, result: Result) -> float:
+    """Prize of a result's plan (-1 without one, so any plan beats no plan)."""
+    if result.plan is None or result.termination is Termination.ERROR:
+        return -1.0
+    return float(sum(instance.prizes[v] for v in result.plan.visited))
+
+
+def routing(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0) -> Result:
+    """OR-Tools routing heuristic: a plan or none, never a bound (``seed`` unused)."""
+    t0 = time.perf_counter()
+    cap = min(DEFAULT_TIME_CAP if time_limit is None else float(time_limit), TIME_CAP)
+    result = solve_routing(instance, time_limit=COLD_SHARE * cap if instance.groups else cap)
+    result.info["phase"] = "cold"
+    if instance.groups:
+        start = greedy(instance)
+        remaining = cap - (time.perf_counter() - t0)
+        if start.plan is not None and remaining > 0.05 and _prize(instance, result) < _prize(instance, start):
+            warm = solve_routing(instance, time_limit=remaining,
+                                 initial_routes=[list(r) for r in start.plan.routes])
+            warm.info["phase"] = "greedy warm start"
+            if _prize(instance, warm) >= _prize(instance, result):
+                result = warm
+    result.method = "routing"
+    result.runtime_s = time.perf_counter() - t0
+    return result

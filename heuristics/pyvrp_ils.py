@@ -24,10 +24,9 @@ Model (PyVRP's ``Model`` builder):
      drop group covers, so :func:`cover_groups` repairs coverage: each uncovered group gets its
      cheapest feasible insertion (hardest group first), evicting the visits with the least
      prize per saved energy (never a group's last visit) while nothing fits.
-  The better covering plan wins (pass 1 on ties). Measured at M=20, K=3, N=5 (seeds 0-7):
-  pass 1 alone 381 views in 2.2 s per run, both passes 386 views in 5.3 s; pass 2 alone
-  (cold, then repair) was worse than pass 1 and its repair failed on seed 0. No covering
-  plan from either pass is NO_PLAN.
+  The better covering plan wins (pass 1 on ties). Both passes together beat pass 1 alone; pass 2
+  alone (cold, then repair) was worse and its repair could fail (``docs/heuristics.md``). No
+  covering plan from either pass: no plan.
 - stop (each pass): ``MaxIterations(ITERATIONS)`` (reproducible: same seed, same plan) or the time limit,
   whichever comes first (``info["stopped_by"]``). Single-threaded.
 """
@@ -42,7 +41,8 @@ from pyvrp import Model, Solution
 from pyvrp.stop import MaxIterations, MaxRuntime, MultipleCriteria
 
 from sarcover.formulations.instance import TOPInstance
-from sarcover.formulations.plan import Plan, Result, Status
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.result import Result, Termination
 from sarcover.formulations.scaling import integer_prizes, scaled_costs
 from sarcover.heuristics.insertion import RouteSet
 
@@ -240,19 +240,19 @@ def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60
     what = "target" if instance.kind == "sar" else "group"
     if len(nodes) == 0:
         if instance.groups:
-            return Result("pyvrp", Status.NO_PLAN, reason=f"no {what} node is reachable",
+            return Result("pyvrp", Termination.COMPLETED, reason=f"no {what} node is reachable",
                           runtime_s=time.perf_counter() - t0, info=info)
-        return Result("pyvrp", Status.FEASIBLE, plan=Plan.of([[] for _ in range(instance.n_vehicles)]),
+        return Result("pyvrp", Termination.COMPLETED, plan=Plan.of([[] for _ in range(instance.n_vehicles)]),
                       runtime_s=time.perf_counter() - t0, info={**info, "stopped_by": "trivial"})
     if not instance.groups:
         routes, run_info = _solve(instance, nodes, False, seed, cap)
         info.update(run_info)
         if routes is None:
-            return Result("pyvrp", Status.NO_PLAN, reason="PyVRP found no plan within the budget",
+            return Result("pyvrp", Termination.COMPLETED, reason="PyVRP found no plan within the budget",
                           runtime_s=time.perf_counter() - t0, info=info)
         if run_info["duplicates_dropped"]:
             routes = cover_groups(instance, routes, refill=True)
-        return Result("pyvrp", Status.FEASIBLE, plan=Plan.of(routes), runtime_s=time.perf_counter() - t0, info=info)
+        return Result("pyvrp", Termination.COMPLETED, plan=Plan.of(routes), runtime_s=time.perf_counter() - t0, info=info)
 
     # pass 1: cover copies, so PyVRP itself covers every group; then dedupe and refill
     reason = "PyVRP found no plan within the budget"
@@ -275,6 +275,17 @@ def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60
                 info["best_pass"] = 2
     if best_routes is not None:
         info.setdefault("best_pass", 1)
-        return Result("pyvrp", Status.FEASIBLE, plan=Plan.of(best_routes),
+        return Result("pyvrp", Termination.COMPLETED, plan=Plan.of(best_routes),
                       runtime_s=time.perf_counter() - t0, info=info)
-    return Result("pyvrp", Status.NO_PLAN, reason=reason, runtime_s=time.perf_counter() - t0, info=info)
+    return Result("pyvrp", Termination.COMPLETED, reason=reason, runtime_s=time.perf_counter() - t0, info=info)
+
+
+def primal_routes(instance: TOPInstance, seed: int):
+    """A primal heuristic for bp: ``run(seconds)`` returns PyVRP's routes (node ids) within that
+    time, or None without a plan."""
+
+    def run(seconds: float):
+        res = pyvrp(instance, seed=seed, time_limit=max(seconds, 0.05))
+        return None if res.plan is None else [list(r) for r in res.plan.routes]
+
+    return run
