@@ -41,7 +41,6 @@ one :class:`SuiteError` line naming the problem.
 
 from __future__ import annotations
 
-import csv
 import glob
 import hashlib
 import importlib
@@ -51,10 +50,10 @@ import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from sarcover.benchmarks.catalog import TOP_DIR, is_benchmark_name, published_optimum
 from sarcover.formulations.errors import SarcoverError
 
 SUITES_DIR = Path(__file__).resolve().parent / "suites"
-TOP_DIR = Path(__file__).resolve().parent / "instances" / "top"
 
 DEFAULT_MEMORY_MB = 4096
 _SUITE_KEYS = {"name", "description", "methods", "time_limit", "seeds", "grace", "memory_mb", "method", "instances"}
@@ -279,7 +278,7 @@ def _file_sources(files, base: Path, where: str):
         raise SuiteError(f"{where}: files must be a non-empty list of file names")
     out = []
     for entry in files:
-        if "/" not in entry and not entry.endswith((".txt", ".json")):
+        if is_benchmark_name(entry):
             pattern = str(TOP_DIR / f"{entry}.txt")
         else:
             pattern = str(base / entry)
@@ -290,32 +289,12 @@ def _file_sources(files, base: Path, where: str):
             p = Path(f).resolve()
             if not p.is_file():
                 raise SuiteError(f"{where}: {entry!r} is not a file")
-            ref = _published_optimum(p)
+            ref = published_optimum(p)
             inst_id = p.stem
             if p.parent != TOP_DIR:
                 inst_id = f"{p.stem}-{hashlib.sha1(str(p).encode()).hexdigest()[:6]}"
             out.append((inst_id, {"type": "file", "path": str(p), "reference": ref}, 0))
     return out
-
-
-_OPTIMA: dict[Path, dict[str, float]] = {}
-
-
-def _published_optimum(path: Path) -> float | None:
-    """The value in optimal.csv next to the file (status optimal only), else None."""
-    table = path.parent / "optimal.csv"
-    if table not in _OPTIMA:
-        values = {}
-        if table.is_file():
-            with table.open() as fh:
-                for row in csv.DictReader(fh):
-                    if row.get("status", "optimal") == "optimal":
-                        try:
-                            values[row["instance"]] = float(row["value"])
-                        except (KeyError, TypeError, ValueError):
-                            continue
-        _OPTIMA[table] = values
-    return _OPTIMA[table].get(path.stem)
 
 
 def _no_unknown(table: dict, allowed: set, where: str) -> None:

@@ -425,7 +425,7 @@ def test_own_folder_of_instance_files_gives_share_proven_and_certified_gaps(tmp_
     size and bounds the gap of the runs it did not prove by their certified bound."""
     import shutil
 
-    from sarcover.benchmarks.suite import TOP_DIR
+    from sarcover.benchmarks.catalog import TOP_DIR
     from sarcover.formulations.generate import generate
     from sarcover.formulations.io import save_json
 

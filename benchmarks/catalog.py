@@ -1,0 +1,62 @@
+"""The benchmark instances shipped with sarcover: names, files and published values.
+
+The Chao-Golden-Wasil TOP files live in ``instances/top/`` beside this module, with their
+published values in ``optimal.csv`` (columns ``instance,value,status,source``; ``status`` is
+``optimal`` for a proven value, ``best_known`` for the best published plan) and their
+provenance in ``PROVENANCE.md``. A benchmark name (``p2.3.g``) stands for its file wherever an
+instance file is read: suites, ``sarcover solve`` and :func:`sarcover.read_instance`.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+TOP_DIR = Path(__file__).resolve().parent / "instances" / "top"
+
+
+def is_benchmark_name(text: str) -> bool:
+    """True for a bare name like ``p2.3.g`` (no folder, no file ending), which names a shipped file."""
+    return "/" not in text and "\\" not in text and not text.endswith((".txt", ".json"))
+
+
+def benchmark_file(name: str) -> Path | None:
+    """The shipped TOP file of benchmark ``name``, or None if there is none."""
+    path = TOP_DIR / f"{name}.txt"
+    return path if is_benchmark_name(name) and path.is_file() else None
+
+
+def instance_path(name_or_path: str | Path) -> Path:
+    """A path as given, or the shipped file of a benchmark name (when no such path exists)."""
+    path = Path(name_or_path)
+    if not path.exists():
+        shipped = benchmark_file(str(name_or_path))
+        if shipped is not None:
+            return shipped
+    return path
+
+
+_TABLES: dict[Path, dict[str, tuple[float, str]]] = {}
+
+
+def published(path: str | Path) -> tuple[float, str] | None:
+    """(value, status) published for the file at ``path``, from the ``optimal.csv`` beside it."""
+    path = Path(path)
+    table = path.parent / "optimal.csv"
+    if table not in _TABLES:
+        values = {}
+        if table.is_file():
+            with table.open() as fh:
+                for row in csv.DictReader(fh):
+                    try:
+                        values[row["instance"]] = (float(row["value"]), row.get("status") or "optimal")
+                    except (KeyError, TypeError, ValueError):
+                        continue
+        _TABLES[table] = values
+    return _TABLES[table].get(path.stem)
+
+
+def published_optimum(path: str | Path) -> float | None:
+    """The proven optimum published for the file at ``path`` (status ``optimal``), else None."""
+    entry = published(path)
+    return entry[0] if entry is not None and entry[1] == "optimal" else None
