@@ -55,8 +55,3 @@ def published(path: str | Path) -> tuple[float, str] | None:
         _TABLES[table] = values
     return _TABLES[table].get(path.stem)
 
-
-def published_optimum(path: str | Path) -> float | None:
-    """The proven optimum published for the file at ``path`` (status ``optimal``), else None."""
-    entry = published(path)
-    return entry[0] if entry is not None and entry[1] == "optimal" else None

@@ -102,7 +102,7 @@ def base_row(job: dict) -> dict:
     """A row of the schema's fields (:data:`~sarcover.formulations.records.FIELDS`, in order): the
     job's identity and provenance, and the outcome of a job that has not run (an error)."""
     src = job["source"]
-    source = {k: v for k, v in src.items() if k not in ("exact", "reference")}
+    source = {k: v for k, v in src.items() if k not in ("exact", "reference", "best_known")}
     row = dict.fromkeys(FIELDS)
     row.update({
         "schema": SCHEMA_VERSION, "key": job["key"], "suite": job.get("suite"),
@@ -110,7 +110,7 @@ def base_row(job: dict) -> dict:
         "seed": job["seed"], "run": job["run"], "source": source,
         "kind": "sar" if src["type"] == "generate" else None,
         "M": src.get("M"), "K": src.get("K"), "N": src.get("N"), "instance_seed": src.get("instance_seed"),
-        "reference": src.get("reference"),
+        "reference": src.get("reference"), "best_known": src.get("best_known"),
         "termination": "error", "solution": "none", "status": "error", "valid": False, "reason": "", "info": {},
         "time_limit": job["time_limit"], "workers": job.get("workers"), **environment(), "pid": os.getpid(),
     })

@@ -50,7 +50,7 @@ import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from sarcover.benchmarks.catalog import TOP_DIR, is_benchmark_name, published_optimum
+from sarcover.benchmarks.catalog import TOP_DIR, is_benchmark_name, published
 from sarcover.formulations.errors import SarcoverError
 
 SUITES_DIR = Path(__file__).resolve().parent / "suites"
@@ -289,11 +289,13 @@ def _file_sources(files, base: Path, where: str):
             p = Path(f).resolve()
             if not p.is_file():
                 raise SuiteError(f"{where}: {entry!r} is not a file")
-            ref = published_optimum(p)
+            value, status = published(p) or (None, None)
             inst_id = p.stem
             if p.parent != TOP_DIR:
                 inst_id = f"{p.stem}-{hashlib.sha1(str(p).encode()).hexdigest()[:6]}"
-            out.append((inst_id, {"type": "file", "path": str(p), "reference": ref}, 0))
+            out.append((inst_id, {"type": "file", "path": str(p),
+                                  "reference": value if status == "optimal" else None,
+                                  "best_known": value if status == "best_known" else None}, 0))
     return out
 
 

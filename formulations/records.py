@@ -13,7 +13,8 @@ Row fields (``schema`` 2; :data:`FIELDS` lists them):
   ``seed`` (method seed), ``run`` (index within the setting and method), ``source`` (how to rebuild
   the instance: generator parameters or file path), ``kind`` (``sar``/``top``), ``M``, ``K``, ``N``,
   ``instance_seed`` (random sets), ``n_nodes``, ``n_groups``, ``n_vehicles``, ``reference``
-  (published value of a benchmark file and its ``status``, or null);
+  (the proven optimum published for a benchmark file, or null), ``best_known`` (the best value
+  published for a file whose optimum is not proven, a lower bound on it, or null);
 - outcome: ``termination`` (why the run stopped: optimal, infeasible, time_limit, completed,
   error), ``solution`` (what it found: optimal, feasible, none), ``status`` (the one word that
   combines both, see :class:`~sarcover.formulations.result.Status`), ``objective`` (the
@@ -44,7 +45,7 @@ SCHEMA_VERSION = 2
 RESULTS_FILE = "results.jsonl"
 
 IDENTITY = ("schema", "key", "suite", "instance", "method", "exact", "seed", "run", "source", "kind", "M", "K",
-            "N", "instance_seed", "n_nodes", "n_groups", "n_vehicles", "reference")
+            "N", "instance_seed", "n_nodes", "n_groups", "n_vehicles", "reference", "best_known")
 OUTCOME = ("termination", "solution", "status", "objective", "bound", "coverage", "covered", "routes", "energy",
            "energy_used", "e_max", "valid", "reason", "info")
 COST = ("runtime_s", "wall_s", "cpu_s", "time_limit", "threads", "workers")

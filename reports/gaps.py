@@ -12,8 +12,10 @@ proven gaps. Runs without a plan (``no_plan``, ``infeasible``, ``time_limit`` wi
 ``error``) have no gap; they are counted in their own columns.
 
 Consistency checks (a wrong "optimal" is the worst bug): two different proven optima on one
-instance, a verified objective above the proven optimum, or a bound below a verified objective are
-listed as conflicts.
+instance, a verified objective above the proven optimum, a bound below a verified objective, or a
+proven optimum or bound below a published best known value (``best_known``, a lower bound) are
+listed as conflicts. A verified plan above a published best known value is news: it is listed in
+the ``news`` column (a new best known value, to be reported with its routes).
 """
 
 from __future__ import annotations
@@ -51,11 +53,22 @@ def instance_table(df: pd.DataFrame) -> pd.DataFrame:
             conflicts.append(f"objective {best_obj:g} above proven optimum {opt:g}")
         if not np.isnan(best_bound) and not np.isnan(best_obj) and best_bound < best_obj - _rel(best_obj):
             conflicts.append(f"bound {best_bound:g} below objective {best_obj:g}")
+        bk_values = g["best_known"].dropna() if "best_known" in g else pd.Series(dtype=float)
+        best_known = float(bk_values.iloc[0]) if len(bk_values) else np.nan
+        news = ""
+        if not np.isnan(best_known):
+            if not np.isnan(opt) and opt < best_known - _rel(best_known):
+                conflicts.append(f"proven optimum {opt:g} below published best known {best_known:g}")
+            if not np.isnan(best_bound) and best_bound < best_known - _rel(best_known):
+                conflicts.append(f"bound {best_bound:g} below published best known {best_known:g}")
+            if not np.isnan(best_obj) and best_obj > best_known + _rel(best_known):
+                news = f"new best known {best_obj:g} (published {best_known:g})"
         first = g.iloc[0]
         out.append({
             "instance": inst, "kind": first.get("kind"), "n_nodes": first.get("n_nodes"),
             "opt": opt, "opt_source": "+".join(sources) if candidates else "",
-            "best_bound": best_bound, "best_objective": best_obj, "conflict": "; ".join(conflicts),
+            "best_bound": best_bound, "best_objective": best_obj, "best_known": best_known,
+            "conflict": "; ".join(conflicts), "news": news,
         })
     return pd.DataFrame(out).set_index("instance")
 

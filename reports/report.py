@@ -366,6 +366,11 @@ def write_report(results_dir: str | Path, out_dir: str | Path) -> str:
         doc.table(conflicts[["opt", "opt_source", "best_bound", "best_objective", "conflict"]])
     else:
         doc.p("No conflicts: proven optima agree, no verified objective exceeds a proven optimum or a bound.")
+    news = inst[inst["news"] != ""] if "news" in inst else inst.iloc[:0]
+    if len(news):
+        doc.p(f"NEW BEST KNOWN values on {len(news)} instances (a verified plan above the published best known "
+              "value; the plan's routes are in runs.csv):")
+        doc.table(news[["best_known", "best_objective", "best_bound", "news"]])
     errors = gapped[gapped["status"] == "error"]
     if len(errors):
         tab = errors.groupby(["method", "reason"]).size().rename("runs").reset_index()

@@ -86,10 +86,12 @@ def test_all_shipped_top_files_parse():
     names = {p.stem for p in TOP_DIR.glob("p*.txt")}
     with open(TOP_DIR / "optimal.csv") as f:
         rows = {r["instance"]: r for r in csv.DictReader(f)}
-    assert names == set(rows) and len(names) == 117
+    assert names == set(rows) and len(names) == 309
+    size = {"p1": 32, "p2": 21, "p3": 33, "p4": 100, "p5": 66, "p6": 64, "p7": 102}  # points, both depots
     for p in TOP_DIR.glob("p*.txt"):
         inst = read_top(p)
-        assert inst.n_nodes + 2 in (21, 32, 33)
+        assert inst.n_nodes + 2 == size[p.stem[:2]]
+        assert rows[p.stem]["status"] in ("optimal", "best_known")
 
 
 def test_bad_top_file(tmp_path):

@@ -195,7 +195,7 @@ def test_registered_method_starts_from_greedy():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", sorted(PUBLISHED))
+@pytest.mark.parametrize("name", sorted(n for n in PUBLISHED if n.split(".")[0] in ("p1", "p2", "p3")))
 def test_top_sets_1_to_3(name):
     """Every TOP instance of sets 1-3 in 60 s: optimal equals published, bound >= published >= objective."""
     result, _ = solve(read_top(TOP_DIR / f"{name}.txt"), time_limit=60.0)

@@ -48,6 +48,14 @@ def test_nine_of_proven_ten_is_ten_percent_and_bound_gap_is_separate():
     assert m.loc["exact", "share_optimal"] == 1.0
 
 
+def test_a_plan_above_a_best_known_value_is_news_not_a_conflict():
+    """A best known value is a lower bound: beating it is reported as news; matching it is not."""
+    table = instance_table(frame(row("a", "x", "time_limit", 12.0, 14.0, best_known=11.0),
+                                 row("b", "x", "time_limit", 11.0, 14.0, best_known=11.0)))
+    assert table.loc["a", "news"] == "new best known 12 (published 11)" and table.loc["a", "conflict"] == ""
+    assert table.loc["b", "news"] == "" and np.isnan(table.loc["b", "opt"])
+
+
 def test_published_optimum_counts_as_proven():
     """A benchmark file's published optimum is the reference even when no method proves it."""
     df = frame(row("p", "heur", "feasible", 45.0, reference=50.0))
@@ -59,6 +67,8 @@ def test_published_optimum_counts_as_proven():
     ((row("a", "x", "optimal", 10.0, 10.0), row("a", "y", "optimal", 11.0, 11.0)), "proven optima disagree"),
     ((row("a", "x", "optimal", 10.0, 10.0), row("a", "h", "feasible", 11.0)), "above proven optimum"),
     ((row("a", "x", "time_limit", 8.0, 9.0), row("a", "h", "feasible", 9.5)), "bound 9 below objective 9.5"),
+    ((row("a", "x", "time_limit", 8.0, 9.0, best_known=9.5),), "bound 9 below published best known 9.5"),
+    ((row("a", "x", "optimal", 9.0, 9.0, best_known=9.5),), "proven optimum 9 below published best known 9.5"),
 ])
 def test_conflicts_are_flagged(rows, needle):
     """A wrong optimum or bound shows up as a conflict on the instance, never silently."""

@@ -133,7 +133,7 @@ def test_random_instances_verified(method):
 
 def _optima():
     with open(TOP_DIR / "optimal.csv") as fh:
-        return {r["instance"]: float(r["value"]) for r in csv.DictReader(fh)}
+        return {r["instance"]: float(r["value"]) for r in csv.DictReader(fh) if r["instance"][:2] in ("p1", "p2", "p3")}
 
 
 @pytest.mark.parametrize("method", PEERS)
