@@ -263,12 +263,17 @@ def test_builtin_suites_load_with_registered_methods():
 
     assert {"quick", "exact-small", "paper-n", "paper-k", "top-chao"} <= set(builtin_suites())
     for name in builtin_suites():
-        suite = load_suite(name, runs=None if name == "top-chao" else 2)
+        suite = load_suite(name, runs=None if name.startswith("top-") else 2)
         assert suite.jobs, name
     paper_n = load_suite("paper-n", runs=2)
     assert {(j.source["M"], j.source["K"], j.source["N"]) for j in paper_n.jobs} == {(20, 3, n) for n in range(2, 7)}
     assert not any(j.source["exact"] for j in paper_n.jobs)
     assert load_suite("top-chao").n_instances == 117
+    top47 = load_suite("top-4-7")
+    assert top47.n_instances == 192 and top47.methods == ["bp"]
+    refs = [(j.source["reference"], j.source["best_known"]) for j in top47.jobs]
+    assert all((r is None) != (b is None) for r, b in refs)  # each file: a proven optimum or a best known value
+    assert sum(r is not None for r, _ in refs) == 50
 
 
 def test_progress_bar_counts_and_eta():
