@@ -21,6 +21,8 @@ Schema (every key but ``methods`` and ``[[instances]]`` is optional)::
     seed = 0                           # first instance seed (default 0)
     preset = "paper"                   # generator preset; overrides: altitude, pitch_deg, e_fly, e_image, e_max
     methods = ["greedy"]               # optional: only these of the suite's methods on this set
+    [instances.method.bp]              # optional: per-method overrides for this set only
+    time_limit = 300
 
     [[instances]]                      # instance files
     files = ["p2.2.*", "my.json"]      # a bare name or glob is looked up among the TOP benchmark files
@@ -58,9 +60,9 @@ SUITES_DIR = Path(__file__).resolve().parent / "suites"
 DEFAULT_MEMORY_MB = 4096
 _SUITE_KEYS = {"name", "description", "methods", "time_limit", "seeds", "grace", "memory_mb", "method", "instances"}
 _METHOD_KEYS = {"time_limit", "seeds", "grace"}
-_GEN_KEYS = {"M", "K", "N", "runs", "seed", "preset", "methods", "label"}
+_GEN_KEYS = {"M", "K", "N", "runs", "seed", "preset", "methods", "label", "method"}
 _GEN_OVERRIDES = ("altitude", "pitch_deg", "e_fly", "e_image", "e_max")
-_FILE_KEYS = {"files", "methods", "label"}
+_FILE_KEYS = {"files", "methods", "label", "method"}
 
 
 class SuiteError(SarcoverError):
@@ -168,18 +170,7 @@ def _build(data: dict, path: Path, text: str, runs_override: int | None) -> Suit
     options = {}
     for m in methods:
         options[m] = dict(defaults)
-    for m, opts in per_method.items():
-        if m not in methods:
-            raise SuiteError(f"{where}: [method.{m}] names a method not in methods")
-        if not isinstance(opts, dict):
-            raise SuiteError(f"{where}: [method.{m}] must be a table")
-        _no_unknown(opts, _METHOD_KEYS, f"{where}: [method.{m}]")
-        if "time_limit" in opts:
-            options[m]["time_limit"] = _number(opts["time_limit"], f"{where}: [method.{m}] time_limit")
-        if "seeds" in opts:
-            options[m]["seeds"] = _integer(opts["seeds"], f"{where}: [method.{m}] seeds", 1)
-        if "grace" in opts:
-            options[m]["grace"] = _number(opts["grace"], f"{where}: [method.{m}] grace", allow_zero=True)
+    options = _method_options(per_method, options, methods, where, "method")
     sets = data.get("instances")
     if not isinstance(sets, list) or not sets or not all(isinstance(s, dict) for s in sets):
         raise SuiteError(f"{where}: at least one [[instances]] table is needed")
@@ -193,6 +184,7 @@ def _build(data: dict, path: Path, text: str, runs_override: int | None) -> Suit
         for m in set_methods:
             if m not in methods:
                 raise SuiteError(f"{swhere}: method {m!r} is not in the suite's methods")
+        set_options = _method_options(spec.get("method", {}), options, methods, swhere, "instances.method")
         if "files" in spec:
             _no_unknown(spec, _FILE_KEYS, swhere)
             instances = _file_sources(spec["files"], path.parent, swhere)
@@ -202,7 +194,7 @@ def _build(data: dict, path: Path, text: str, runs_override: int | None) -> Suit
             if sources.setdefault(inst_id, source) != source:
                 raise SuiteError(f"{swhere}: instance name {inst_id!r} is used for two different instances")
             for m in set_methods:
-                opt = options[m]
+                opt = set_options[m]
                 for s in range(opt["seeds"]):
                     tl = opt["time_limit"]
                     grace = opt["grace"] if opt["grace"] is not None else 5.0 + 0.2 * tl
@@ -212,6 +204,27 @@ def _build(data: dict, path: Path, text: str, runs_override: int | None) -> Suit
     if runs_override is not None and all("files" in spec for spec in sets):
         raise SuiteError(f"{where}: --runs sets the random instances per setting, and this suite has only files")
     return Suite(name, path, text, str(data.get("description", "")), methods, list(jobs.values()), memory_mb)
+
+
+def _method_options(tables, base: dict, methods: list[str], where: str, table: str) -> dict:
+    """``base`` (method -> options) with the ``[table.NAME]`` overrides of ``tables`` applied:
+    the suite's ``[method.NAME]``, or an instance set's ``[instances.method.NAME]``."""
+    if not isinstance(tables, dict):
+        raise SuiteError(f"{where}: [{table}.NAME] tables expected")
+    options = {m: dict(o) for m, o in base.items()}
+    for m, opts in tables.items():
+        if m not in methods:
+            raise SuiteError(f"{where}: [{table}.{m}] names a method not in methods")
+        if not isinstance(opts, dict):
+            raise SuiteError(f"{where}: [{table}.{m}] must be a table")
+        _no_unknown(opts, _METHOD_KEYS, f"{where}: [{table}.{m}]")
+        if "time_limit" in opts:
+            options[m]["time_limit"] = _number(opts["time_limit"], f"{where}: [{table}.{m}] time_limit")
+        if "seeds" in opts:
+            options[m]["seeds"] = _integer(opts["seeds"], f"{where}: [{table}.{m}] seeds", 1)
+        if "grace" in opts:
+            options[m]["grace"] = _number(opts["grace"], f"{where}: [{table}.{m}] grace", allow_zero=True)
+    return options
 
 
 def check_method(name: str, where: str) -> bool:

@@ -220,6 +220,10 @@ def test_existing_results_need_resume(tmp_path, capsys):
     ('methods = ["greedy"]\n[[instances]]\nfiles = ["missing.json"]', "instance file 'missing.json' not found"),
     ('methods = ["greedy"]\n[method.milp]\ntime_limit = 3\n[[instances]]\nM = 3\nK = 2\nN = 1', "[method.milp]"),
     ('methods = ["greedy"\n', "not valid TOML"),
+    ('methods = ["greedy"]\n[[instances]]\nM = 3\nK = 2\nN = 1\n[instances.method.bp]\ntime_limit = 3',
+     "[instances.method.bp] names a method not in methods"),
+    ('methods = ["greedy"]\n[[instances]]\nM = 3\nK = 2\nN = 1\n[instances.method.greedy]\ntimelimit = 3',
+     "unknown key 'timelimit'"),
 ])
 def test_bad_suite_files_give_one_line_error(tmp_path, capsys, body, needle):
     """Unknown method, bad parameter, missing file: one line naming the problem, exit 2, nothing run."""
@@ -228,6 +232,28 @@ def test_bad_suite_files_give_one_line_error(tmp_path, capsys, body, needle):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and needle in err and "bad.toml" in err, err
     assert not (tmp_path / "res").exists()
+
+
+def test_an_instance_set_overrides_a_methods_time_limit(tmp_path):
+    """[instances.method.NAME] sets a method's time limit for that set only, over [method.NAME]."""
+    suite = load_suite(str(write_suite(tmp_path, """
+methods = ["greedy", "bp"]
+time_limit = 10
+[method.bp]
+time_limit = 60
+[[instances]]
+M = 3
+K = 2
+N = 1
+[[instances]]
+M = 3
+K = 4
+N = 1
+[instances.method.bp]
+time_limit = 300
+""")))
+    limits = {(j.source["K"], j.method): j.time_limit for j in suite.jobs}
+    assert limits == {(2, "greedy"): 10, (2, "bp"): 60, (4, "greedy"): 10, (4, "bp"): 300}
 
 
 def test_unknown_suite_name_lists_builtins(capsys):
