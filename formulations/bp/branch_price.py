@@ -1,133 +1,17 @@
 """Branch-and-price for the team orienteering problem with group cover: the ``bp`` method.
 
 Each branch-and-bound node runs column generation on the route master (:mod:`.master`) with the
-labelling pricing (:mod:`.pricing`):
+labelling pricing (:mod:`.pricing`): heuristic pricing, then exact pricing over ng-routes (its
+best reduced prize gives the node's certified Lagrangian bound; improving ng-routes that repeat a
+point enter the master with visit counts), targeted below the root at the next point of the prize
+lattice that matters; ng sets grow from the LP's repeated routes early in the run; at the root,
+limited-memory subset-row cuts on long runs, and reduced-cost arc elimination under the duals
+that certified the root bound. Branching on node visits, then arc flows, with strong branching;
+nodes best floored bound first. Incumbents from dives, the caller's ``primal`` heuristic, integral
+LP solutions and a MILP over the generated routes. The reported bound is max(incumbent, floored
+bounds of the open nodes), certified at every stop.
 
-1. heuristic pricing (dominance without remembered sets) until it finds no improving route;
-2. exact pricing over ng-routes (a relaxation of elementary routes): its best reduced prize gives
-   the certified Lagrangian bound of the round. Improving routes become columns, elementary or
-   not: an ng-route that repeats a point enters the master with visit-count coefficients, so it
-   can never be part of an integer solution but keeps the LP the ng-route relaxation that the
-   pricing bounds exactly (no ng growth is needed for the column generation to converge).
-   One-way or bidirectional exact labelling, whichever the first exact call measures faster.
-3. targeted exact pricing: with integer prizes a bound only matters rounded down to the prize
-   lattice (multiples of the prizes' gcd). The exact call's threshold is raised from the vehicle
-   dual to what N routes may add without reaching the next lattice point above the dual value
-   (or incumbent + step, if higher); when nothing beats it the node's floored bound is settled and
-   the node is pruned or branched on at once, without converging the LP's tail. Not at the root:
-   its LP is converged, because converged duals make the arc elimination (6.) much stronger
-   (seed 5 below: 1060 arcs eliminated with the targeted root's duals, 1701 with converged ones).
-4. dynamic ng sets: when the node's LP solution uses a route that repeats a point u, u is
-   remembered at the points of its cycle (ng sets capped at ``ng_cap`` = 12), the routes that stop
-   being ng-routes leave the master, and column generation continues on the stronger relaxation.
-   Larger ng sets make pricing slower, so sets only grow in the first ``grow_share`` (30 %) of the
-   time limit; after that, branching decides.
-5. limited-memory subset-row cuts (:mod:`.master`), on by default for time limits of at least
-   ``CUTS_FROM_S`` (60 s; ``cut_rounds`` = 0 turns them off, a number turns them on): at the
-   root, once the floored bound is settled and the ng sets stop growing, up to ``cut_rounds``
-   (6) rounds of ``cuts_per_round`` (16) most violated triples, each followed by column
-   generation with the cut duals in the pricing. At most 64 cuts at a time: when a round would
-   pass that, the cuts of zero dual are removed first. Cuts make every later pricing slower
-   (labels carry cut parities and dominate less), so they are tried only within the first
-   ``cut_share`` (35 %) of the time limit and only while the restricted LP is within ``cut_gap``
-   (half a prize step; from ``OPEN_CUTS_FROM_S`` = 300 s one step, i.e. always, see
-   :func:`default_cut_gap`) of proving the incumbent or of lowering its own floor by one step.
-6. reduced-cost arc elimination: under the duals y that certified the root bound, a plan better
-   than the incumbent can only use routes of reduced prize >= incumbent + step - dual term -
-   (N-1)·rc*. An arc through which no route reaches that (by a 2-cycle-free DP over energy
-   units, :func:`.pricing.arc_bounds`, whenever the certificate or the incumbent changes; once
-   the root LP is solved also by exact ng-labelling both ways, :func:`.pricing.label_arc_bounds`,
-   about two exact pricing calls; when cuts are on, before their first round, so that the cut
-   rounds price on the smaller graph, and again at the end of the root) leaves the pricing graph
-   and the LP of every node. Node bounds then only cover plans better than the incumbent: enough
-   for pruning, and the reported bound is never below the incumbent. On M = 20, K = 3 about half
-   of the 3600 arcs go at the root (all of them once the incumbent is optimal); pricing, LPs and
-   strong branching get faster. Labelling before the cuts (2026-12-02, seeds 0..7 at 60 s, two
-   processes side by side, before/after): 33.0/12.7, 22.4/23.3, 38.3/38.2, 10.4/11.5,
-   16.1/14.5, 48.6/47.9, 23.9/20.1, 16.4/16.2 s on seeds 0..7 (all 8 proven either way).
-
-Branching, in order: on a fractional node visit (forbid the node / force it visited: a forced node
-row becomes ``= 1``); then, when all visits are integral, on a fractional arc flow (forbid the arc
-/ force it: the tail may only go to the head and the head may only be reached from the tail).
-Both keep the pricing a plain labelling on a modified graph. Strong branching picks among the
-``strong`` (5) most fractional candidates the one whose two children, re-solved on the current
-columns without pricing (an estimate), drop most below the node's LP value (product of the
-drops). On seed 5 below (cuts off, 300 s, side by side) it proved the optimum in 134 s with 95
-nodes (32 s of them in the estimates, before the exclusions were vectorised), where the most
-fractional choice alone left 7 nodes open after 316. With integral visits and arc flows an
-LP solution of elementary routes is integral (each positive route follows the unique flow-1 arcs);
-a node where that still fails (repeated routes) stays unresolved and the run is not reported
-proven. Nodes are explored best floored bound first, deepest first among equals (depth first
-until a plan of the best floored value turns up); a node is pruned when its floored bound does not
-exceed the incumbent.
-
-Incumbents: dives (fix the route of largest LP value by forcing its nodes and arcs, re-price
-heuristically over elementary routes only, repeat until the LP is integral; a failed fixing is
-undone and the next route tried): one as soon as the root's floored bound is settled, one from
-the final root LP, then one every 4 nodes from the node's LP, each starting from a route no
-earlier dive started from; up to 10 % of the time limit each at the root. If the first dive
-leaves the root's proof open, the caller's ``primal`` heuristic (the registered ``bp`` passes
-PyVRP) runs once with ``primal_share`` (10 %) of the limit, at most ``PRIMAL_CAP_S``; its routes
-become columns and a second dive starts from them. Also integral LP solutions and a MILP over
-the generated routes (HiGHS, started from the incumbent) at the root and every 10 nodes. The
-column-generation routes alone
-are poor for the MILP (50-54 where 56-57 exist on M = 20, K = 3); the dives' routes fit together
-(they found 57 on seed 3 and 53 on seed 4 where pyvrp finds 56 and 52), and PyVRP's full run
-finds the optimum on 5 of the 8 seeds.
-
-The reported bound is max(incumbent, floored bounds of the open nodes), certified at every stop;
-a run whose open nodes all floor to the incumbent is reported optimal.
-
-Measured (2026-12-01, 2-core machine, M = 20 targets, K = 3 views, N = 5 UAVs, paper preset,
-seeds 0..7, 60 s through the registry, one thread):
-
-- The DP suffix bound in the pricing (:mod:`.pricing`) cut root exact pricing on seed 5 from
-  0.47 s to 0.05 s without cuts and from 7.5 s to 2.1 s with 64 cuts (side by side, same values).
-- With it and the PyVRP primal: 6 of 8 proven in each of five batches (this code and variants
-  that order the dives and PyVRP differently), run one instance at a time with the other core
-  busy (proofs in 9-59 s); which seeds stay open varies
-  with timing: seed 5 always (bound 56, optimum 55), and seed 4 or seed 1, stopped with the
-  bound at the optimum (53, 57) and the incumbent one short. With both cores running bp jobs
-  (two runs of the reference suite) 5 and 6 of 8. Before today's changes: 6 or 7 of 8.
-- Seed 5 needs cuts: at 300 s (cuts on) it is proven optimal in 99-183 s (root LP 56.35 -> below
-  56 with 96 cuts, 42-47 purged; 1-3 nodes). Earlier, without purging, 64 cuts left the root LP
-  at 56.006 and the proof took 232 s, or did not come within 300 s.
-- K = 6 (120 viewpoints, seeds 0..7): the root LP now converges in 27-46 s; bounds at 60 s 89,
-  96, 98, 100, 89, 93, 94, 95 (before: 90, 97, 98, 100, 89, 94, 95, 95); incumbents 86-98 (PyVRP's
-  plans); at 300 s (seeds 0..3) 88, 95, 98, 99.
-- TOP sets 1-3: all 117 published optima proven, the slowest (p3.3.o) in 5.5 s, 45 s for all 117
-  in one process (before: p3.2.r in 19-26 s).
-
-- 2026-12-02, with the MILP's start and strong branching: 6 of 8 at 60 s in every batch (side
-  by side with and without strong branching, and in the reference suite: seed 4 proven in
-  27 s, seeds 1 and 5 open); seed 5 at 300 s proven in 178 s with cuts (default) and in 134 s
-  with cuts off; K = 6 bounds and incumbents as above.
-- 2026-12-02, with arc elimination (6.), the labelling's best routes as MILP columns and cuts
-  from 60 s: **8 of 8 proven at 60 s** in two batches through the registry (plans verified):
-  two processes side by side 27.6, 8.9, 38.3, 10.9, 50.0, 15.9, 24.1, 15.2 s (seeds 0..7); one
-  process beside a K = 6 batch 10.6, 21.3, 46.6, 14.3, 17.6, 47.8, 25.6, 15.2 s. Seed 5 closes
-  through 32 cuts (root LP 56.35 -> 56.13, 5 nodes); on seeds 1 and 4 the root MILP over the
-  pool finds the optimum (57, 53) that PyVRP (56, 52, with any of 6 seeds), the dives and 60 s
-  of branching had missed. K = 6 (seeds 0..4): bounds 89, 96, 98, 100, 89 as before, since the
-  root converges only at 40-55 s.
-- 2026-12-02 (later), between K = 3 and K = 6 (M = 20, N = 5, two processes side by side): at
-  60 s nothing is proven on K = 4 (80 viewpoints; seeds 0, 1: bound/plan 68/66, 71/69) or K = 5
-  (100 viewpoints; 78/76, 83/82). At 300 s with the open cut gate (:func:`default_cut_gap`) K = 4
-  seed 0 is proven (68, 118 s; 64 cuts, the plan of 68 came after the cuts); K = 4 seed 1 stays
-  at 70/69, K = 5 seed 1 at 83/82, K = 6 seed 0 at 88/86. K = 3 seed 5 at 300 s: proven in
-  76-80 s (labelling before the cuts; 145 s before). Cut rounds during 60 % instead of 35 % of
-  300 s on K = 6 (seeds 0, 1): root LP 89.05 -> 88.60 with 64 cuts, bounds unchanged (88, 95),
-  so the share stays 35 %.
-- Dual smoothing (Wentges, the exact pricing at 0.5 x the best certified duals + 0.5 x the LP's,
-  mispricing -> the LP's duals) was tried and dropped: the same 31 exact pricings on K = 6 seed 0
-  (6 of them mispriced), and K = 3 seed 5 went from proven at 60 s to open.
-
-Subset-row cuts are off below ``CUTS_FROM_S`` (60 s): on a 30-viewpoint instance they once
-turned a 2 s proof into 22 s. Before arc elimination the threshold was 120 s (at 60 s, side by
-side on seeds 0..7, forced cuts proved 5 of 8 both with and without them). With it (2026-12-02,
-seeds 0..7 at 60 s, side by side): cuts on 7 of 8 (seed 5 proven in 49 s: 32 cuts, root LP
-56.35 -> 56.13, 5 nodes), cuts off 6 of 8; K = 6 (seeds 0..3) unchanged: the root converges
-too late (45-55 s) for cuts to start, bounds 89, 96, 98 either way.
+The method in full, its measurements and what was tried and dropped: ``docs/bp.md``.
 """
 
 from __future__ import annotations
@@ -166,10 +50,7 @@ def default_cut_gap(time_limit: float | None) -> float:
     """How close (in prize steps) the restricted root LP must be to a drop that matters (below
     the incumbent + one step, or below its own floor) for a cut round: 0.5 below
     ``OPEN_CUTS_FROM_S``, 1.0 from it (and without a limit), which is no gate at all since an LP
-    value is always less than one step above its floor. Measured at 300 s (2026-12-02, M = 20,
-    N = 5, side by side): K = 4 seed 0 proven optimal (68) in 118 s with 1.0, open after 300 s
-    with 0.5 (bound 68, incumbent 67, no cut round: LP 68.80, incumbent 66 when the gate was
-    checked); K = 4 seed 1, K = 5 seed 1, K = 6 seed 0 and K = 3 seed 5 end the same either way."""
+    value is always less than one step above its floor."""
     return 1.0 if time_limit is None or float(time_limit) >= OPEN_CUTS_FROM_S else 0.5
 
 
