@@ -1,7 +1,7 @@
 """The registered `bp` method: branch-and-price warm-started by heuristics.
 
-``formulations`` may not import heuristics, so :func:`sarcover.formulations.bp.solve_bp` takes optional
-``initial_routes`` and a ``primal`` callback; this glue hands it
+``formulations`` may not import heuristics, so :func:`sarcover.formulations.bp.solve_bp` takes an optional
+``warm_start`` plan and a ``primal`` callback; this glue hands it
 
 - greedy's plan (milliseconds) as the first columns and incumbent, so a run stopped early still
   returns a plan covering every target whenever greedy found one;
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import time
 
-from sarcover.formulations.bp import default_cut_gap, default_cut_rounds, solve_bp
+from sarcover.formulations.bp import BPOptions, solve_bp
 from sarcover.formulations.bp.pricing import warm_up
 from sarcover.formulations.history import shifted
 from sarcover.formulations.plan import Result, Status
@@ -46,18 +46,17 @@ def bp(instance, *, seed: int = 0, time_limit: float | None = 60.0) -> Result:
     warm_up()  # numba compilation (or loading it from the disk cache) is not the method's time
     t0 = time.perf_counter()
     # cuts on the user's limit, not on what greedy leaves of it
-    cut_rounds, cut_gap = default_cut_rounds(time_limit), default_cut_gap(time_limit)
+    options = BPOptions.for_time_limit(time_limit)
     start = greedy(instance, seed=seed)
-    routes = [list(r) for r in start.plan.routes] if start.status == Status.FEASIBLE else None
+    warm_start = start.plan if start.status == Status.FEASIBLE else None
     t1 = time.perf_counter()
     if time_limit is not None:
         time_limit = max(time_limit - (t1 - t0), 0.0)
-    result = solve_bp(instance, seed=seed, time_limit=time_limit, initial_routes=routes,
-                      primal=_pyvrp_routes(instance, seed), cut_rounds=cut_rounds,
-                      cut_gap=cut_gap)
+    result = solve_bp(instance, seed=seed, time_limit=time_limit, warm_start=warm_start,
+                      primal=_pyvrp_routes(instance, seed), options=options)
     result.runtime_s = time.perf_counter() - t0
     if "history" in result.info:  # times from this call, greedy included
         result.info["history"] = shifted(result.info["history"], t1 - t0)
     result.info["warm_start_prize"] = (float(sum(instance.prizes[v] for v in start.plan.visited))
-                                       if routes is not None else None)
+                                       if warm_start is not None else None)
     return result

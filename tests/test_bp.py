@@ -12,10 +12,11 @@ import numpy as np
 import pytest
 
 from sarcover.benchmarks.registry import run_method
-from sarcover.formulations.bp import solve_bp
+from sarcover.formulations.bp import BPOptions, solve_bp
+from sarcover.formulations.bp.options import CUTS_FROM_S, OPEN_CUTS_FROM_S
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.io import load_instance
-from sarcover.formulations.plan import Status
+from sarcover.formulations.plan import Plan, Status
 from sarcover.formulations.verify import route_energy, verify
 
 TOP_DIR = Path(__file__).resolve().parent.parent / "benchmarks" / "instances" / "top"
@@ -113,7 +114,7 @@ def test_groups_force_lower_prize():
 def test_initial_routes_are_used():
     """A warm-start plan is accepted as incumbent and the proof still reaches the optimum."""
     inst = load_instance(TOP_DIR / "p2.2.d.txt")
-    res = solve_bp(inst, time_limit=30, initial_routes=[[0], [1]])
+    res = solve_bp(inst, time_limit=30, warm_start=Plan.of([[0], [1]]))
     assert res.status == Status.OPTIMAL and res.bound == OPTIMAL["p2.2.d"]
 
 
@@ -602,7 +603,7 @@ def test_strong_branching_proves_the_same_optimum():
     from sarcover.formulations.bp.branch_price import BranchAndPrice, NodeState
 
     inst = _top("p3.3.o")
-    results = {st: solve_bp(inst, time_limit=30, strong=st) for st in (1, 5)}
+    results = {st: solve_bp(inst, time_limit=30, options=BPOptions(strong=st)) for st in (1, 5)}
     for st, r in results.items():
         assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p3.3.o"])
         assert verify(inst, r.plan).valid
@@ -770,7 +771,8 @@ def test_purging_cuts_keeps_the_published_optimum():
     """Rounds of 48 cuts on p2.2.k pass the 64-cut limit, so idle cuts are purged between
     rounds; the published optimum is still proven."""
     inst = load_instance(TOP_DIR / "p2.2.k.txt")
-    r = solve_bp(inst, time_limit=60, cut_rounds=4, cuts_per_round=48, cut_gap=100.0, cut_share=1.0)
+    r = solve_bp(inst, time_limit=60, options=BPOptions(cut_rounds=4, cuts_per_round=48, cut_gap=100.0,
+                                                    cut_share=1.0))
     assert r.info["cuts_purged"] > 0
     assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p2.2.k"])
     assert r.bound == pytest.approx(OPTIMAL["p2.2.k"])
@@ -781,7 +783,7 @@ def test_cuts_keep_the_published_optimum(name):
     """With subset-row cuts forced on (these files get 8 to 38 cuts at the root), bp still proves
     exactly the published optimum with a verified plan."""
     inst = load_instance(TOP_DIR / f"{name}.txt")
-    r = solve_bp(inst, time_limit=60, cut_rounds=4, cut_gap=100.0, cut_share=1.0)
+    r = solve_bp(inst, time_limit=60, options=BPOptions(cut_rounds=4, cut_gap=100.0, cut_share=1.0))
     assert r.info["cuts"] > 0
     assert r.status == Status.OPTIMAL
     assert sum(inst.prizes[v] for v in r.plan.visited) == pytest.approx(OPTIMAL[name])
@@ -793,7 +795,7 @@ def test_cuts_match_brute_force(seed):
     """Tiny random instances with groups, cuts forced on: same optimum as enumeration."""
     inst = random_tiny(seed, groups=True)
     best = brute_force(inst)
-    r = solve_bp(inst, time_limit=30, cut_rounds=4, cut_gap=100.0, cut_share=1.0)
+    r = solve_bp(inst, time_limit=30, options=BPOptions(cut_rounds=4, cut_gap=100.0, cut_share=1.0))
     if best is None:
         assert r.status == Status.INFEASIBLE
     else:
@@ -807,13 +809,13 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, thre
     """The registered bp spends a moment on greedy before solve_bp; whether cuts are on, and how
     open their gate is, follow the user's time limit (at CUTS_FROM_S: on; at OPEN_CUTS_FROM_S:
     open), not the slightly smaller one left for solve_bp."""
-    import sarcover.formulations.bp.branch_price as branch_price
+    import sarcover.formulations.bp.options as bp_options
     import sarcover.heuristics.bp_warm as warm
-    from sarcover.formulations.bp.branch_price import (CUTS_FROM_S, OPEN_CUTS_FROM_S, default_cut_gap,
-                                              default_cut_rounds)
+    from sarcover.formulations.bp.options import (CUTS_FROM_S, OPEN_CUTS_FROM_S, default_cut_gap,
+                                                  default_cut_rounds)
     from sarcover.formulations.plan import Result
 
-    limit = getattr(branch_price, threshold) + offset
+    limit = getattr(bp_options, threshold) + offset
     seen = {}
 
     def fake_solve_bp(instance, **kw):
@@ -823,33 +825,63 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, thre
     monkeypatch.setattr(warm, "solve_bp", fake_solve_bp)
     warm.bp(random_tiny(0, groups=False), time_limit=limit)
     assert seen["time_limit"] < limit
-    assert seen["cut_rounds"] == default_cut_rounds(limit) == (6 if limit >= CUTS_FROM_S else 0)
-    assert seen["cut_gap"] == default_cut_gap(limit) == (1.0 if limit >= OPEN_CUTS_FROM_S else 0.5)
+    assert seen["options"].cut_rounds == default_cut_rounds(limit) == (6 if limit >= CUTS_FROM_S else 0)
+    assert seen["options"].cut_gap == default_cut_gap(limit) == (1.0 if limit >= OPEN_CUTS_FROM_S else 0.5)
 
 
 def test_cuts_are_on_by_default_for_long_runs_only():
     """Cuts slow pricing down; by default they are used from CUTS_FROM_S seconds (and without a
     limit) and can be forced either way."""
-    from sarcover.formulations.bp.branch_price import CUTS_FROM_S, BranchAndPrice
+    from sarcover.formulations.bp.branch_price import BranchAndPrice
 
     inst = random_tiny(0, groups=False)
     assert BranchAndPrice(inst, time_limit=CUTS_FROM_S - 1).cut_rounds == 0
     assert BranchAndPrice(inst, time_limit=CUTS_FROM_S).cut_rounds > 0
     assert BranchAndPrice(inst, time_limit=None).cut_rounds > 0
-    assert BranchAndPrice(inst, time_limit=None, cut_rounds=0).cut_rounds == 0
-    assert BranchAndPrice(inst, time_limit=10, cut_rounds=2).cut_rounds == 2
+    assert BranchAndPrice(inst, time_limit=None, options=BPOptions(cut_rounds=0)).cut_rounds == 0
+    assert BranchAndPrice(inst, time_limit=10, options=BPOptions(cut_rounds=2)).cut_rounds == 2
 
 
 def test_cut_gate_opens_for_long_runs():
     """Below OPEN_CUTS_FROM_S a cut round needs the root LP within half a step of a useful drop;
     from it (and without a limit) the gate is open; an explicit cut_gap wins."""
-    from sarcover.formulations.bp.branch_price import OPEN_CUTS_FROM_S, BranchAndPrice
+    from sarcover.formulations.bp.branch_price import BranchAndPrice
 
     inst = random_tiny(0, groups=False)
     assert BranchAndPrice(inst, time_limit=OPEN_CUTS_FROM_S - 1).cut_gap == 0.5
     assert BranchAndPrice(inst, time_limit=OPEN_CUTS_FROM_S).cut_gap == 1.0
     assert BranchAndPrice(inst, time_limit=None).cut_gap == 1.0
-    assert BranchAndPrice(inst, time_limit=None, cut_gap=0.25).cut_gap == 0.25
+    assert BranchAndPrice(inst, time_limit=None, options=BPOptions(cut_gap=0.25)).cut_gap == 0.25
+
+
+@pytest.mark.parametrize("limit", [CUTS_FROM_S - 1, CUTS_FROM_S, OPEN_CUTS_FROM_S - 1,
+                                   OPEN_CUTS_FROM_S, None])
+def test_options_for_time_limit(limit):
+    """BPOptions.for_time_limit: the defaults, with the cut settings decided on the limit (cuts
+    on from CUTS_FROM_S, their gate open from OPEN_CUTS_FROM_S); options that leave them None
+    get the same from the solve's own limit; the options are frozen."""
+    import dataclasses
+
+    opts = BPOptions.for_time_limit(limit)
+    on, open_gate = limit is None or limit >= CUTS_FROM_S, limit is None or limit >= OPEN_CUTS_FROM_S
+    assert opts.cut_rounds == (6 if on else 0) and opts.cut_gap == (1.0 if open_gate else 0.5)
+    assert dataclasses.replace(opts, cut_rounds=None, cut_gap=None) == BPOptions()
+    assert BPOptions().with_limit_defaults(limit) == opts
+    assert BPOptions(cut_rounds=2, strong=1).with_limit_defaults(limit).cut_rounds == 2
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        opts.strong = 1
+
+
+def test_solve_bp_options_override_a_default():
+    """At 30 s cuts are off by default; options=BPOptions(...) turns them on for the same call
+    (and the published optimum is proven either way)."""
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    default = solve_bp(inst, time_limit=30)
+    forced = solve_bp(inst, time_limit=30,
+                      options=BPOptions(cut_rounds=4, cut_gap=100.0, cut_share=1.0))
+    assert default.info["cuts"] == 0 and forced.info["cuts"] > 0
+    for r in (default, forced):
+        assert r.status == Status.OPTIMAL and r.bound == pytest.approx(OPTIMAL["p2.2.k"])
 
 
 def _arcs_of_plans_from(inst: TOPInstance, value: float) -> set:
@@ -874,7 +906,7 @@ def test_arc_elimination_keeps_every_better_plan(seed):
 
     inst = random_tiny(seed, groups=False)
     best = brute_force(inst)
-    bp = BranchAndPrice(inst, time_limit=None, strong=1)
+    bp = BranchAndPrice(inst, time_limit=None, options=BPOptions(strong=1))
     bp.dived = True  # no dive: it could find the optimum and move the floor above it
     bp.incumbent, bp.incumbent_value = [], best - bp.step
     bp.column_generation(NodeState(), math.inf)
@@ -906,7 +938,8 @@ def test_labelling_arc_bounds_run_before_the_first_cut_round():
             return out
 
     inst = load_instance(TOP_DIR / "p2.2.k.txt")
-    bp = Recording(inst, time_limit=60, cut_rounds=4, cut_gap=100.0, cut_share=1.0)
+    bp = Recording(inst, time_limit=60,
+                   options=BPOptions(cut_rounds=4, cut_gap=100.0, cut_share=1.0))
     proven, bound = bp.run()
     kinds = [k for k, _ in events]
     assert "cuts" in kinds and "labels" in kinds
@@ -930,7 +963,7 @@ def test_root_out_of_time_right_after_the_route_pool_joined():
                 self.deadline = self.hard_deadline = time.perf_counter() - 1.0
 
     inst = load_instance(TOP_DIR / "p2.2.k.txt")
-    bp = OutOfTime(inst, time_limit=60, cut_rounds=0)
+    bp = OutOfTime(inst, time_limit=60, options=BPOptions(cut_rounds=0))
     proven, bound = bp.run()
     assert bp.pool_added > 0  # the pool did add columns after the root LP
     assert not proven and bound >= OPTIMAL["p2.2.k"] - 1e-6

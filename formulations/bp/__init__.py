@@ -1,5 +1,6 @@
 """Route-based exact method ``bp``: column generation and branch-and-price on HiGHS."""
 
-from sarcover.formulations.bp.branch_price import default_cut_gap, default_cut_rounds, solve_bp
+from sarcover.formulations.bp.branch_price import solve_bp
+from sarcover.formulations.bp.options import BPOptions
 
-__all__ = ["default_cut_gap", "default_cut_rounds", "solve_bp"]
+__all__ = ["BPOptions", "solve_bp"]

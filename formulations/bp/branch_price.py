@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sarcover.formulations.bp.master import MAX_CUTS, Master
+from sarcover.formulations.bp.options import BPOptions
 from sarcover.formulations.bp.pricing import (add_to_ng, arc_bounds, cheapest_return, full_ng,
                                      label_arc_bounds, nearest_ng, price, warm_up)
 from sarcover.formulations.instance import TOPInstance, precheck
@@ -31,27 +32,6 @@ from sarcover.formulations.plan import Plan, Result, Status
 from sarcover.formulations.verify import verify
 
 TOL = 1e-6
-CUTS_FROM_S = 60.0  # time limits from which subset-row cuts are on by default
-OPEN_CUTS_FROM_S = 300.0  # ... and from which they are tried however far the LP is from a drop
-PRIMAL_SHARE = 0.1  # of the time limit for the caller's heuristic (``primal``) ...
-PRIMAL_CAP_S = 10.0  # ... but at most this many seconds
-STRONG = 5  # branching candidates compared by their children's restricted LPs
-POOL_ROUTES = 2000  # near-optimal routes from the root's labelling arc bounds, for the MILP
-
-
-def default_cut_rounds(time_limit: float | None) -> int:
-    """Rounds of subset-row cuts by default: 6 from ``CUTS_FROM_S`` (and without a limit), else
-    0 (cuts only pay back their slower pricing on long runs). A caller that spends part of the
-    user's limit before :func:`solve_bp` decides on the user's limit."""
-    return 6 if time_limit is None or float(time_limit) >= CUTS_FROM_S else 0
-
-
-def default_cut_gap(time_limit: float | None) -> float:
-    """How close (in prize steps) the restricted root LP must be to a drop that matters (below
-    the incumbent + one step, or below its own floor) for a cut round: 0.5 below
-    ``OPEN_CUTS_FROM_S``, 1.0 from it (and without a limit), which is no gate at all since an LP
-    value is always less than one step above its floor."""
-    return 1.0 if time_limit is None or float(time_limit) >= OPEN_CUTS_FROM_S else 0.5
 
 
 @dataclass(frozen=True)
@@ -106,34 +86,34 @@ class _Stats:
 
 
 class BranchAndPrice:
-    def __init__(self, instance: TOPInstance, *, time_limit: float | None, ng_size: int = 8,
-                 initial_routes=None, bidirectional: bool | None = None, ng_columns: bool = True,
-                 ng_cap: int = 12, grow_share: float = 0.3, cut_rounds: int | None = None,
-                 cuts_per_round: int = 16, cut_gap: float | None = None, cut_share: float = 0.35,
-                 primal=None, primal_share: float = PRIMAL_SHARE, strong: int = STRONG):
+    def __init__(self, instance: TOPInstance, *, time_limit: float | None,
+                 warm_start: Plan | None = None, primal=None, options: BPOptions | None = None):
+        opts = (BPOptions.for_time_limit(time_limit) if options is None
+                else options.with_limit_defaults(time_limit))
+        self.options = opts
         self.primal = primal
-        self.strong = strong
+        self.strong = opts.strong
         self.root_cert = None  # (duals, their dual term, best reduced prize bound, bound)
         self._arc_cert = None  # (root_cert the arc bounds belong to, arc bounds, labelled?)
         self.elim_version = 0  # bumped whenever more arcs are eliminated
-        self.cut_rounds = default_cut_rounds(time_limit) if cut_rounds is None else cut_rounds
-        self.cut_gap = default_cut_gap(time_limit) if cut_gap is None else cut_gap
-        self.cuts_per_round = cuts_per_round
+        self.cut_rounds = opts.cut_rounds
+        self.cut_gap = opts.cut_gap
+        self.cuts_per_round = opts.cuts_per_round
         self.cut_round = 0
         self.labelled_before_cuts = False
-        self.bidirectional = bidirectional
-        self.ng_columns = ng_columns
-        self.ng_cap = ng_cap
+        self.bidirectional = opts.bidirectional
+        self.ng_columns = opts.ng_columns
+        self.ng_cap = opts.ng_cap
         self.inst = instance
         self.t0 = time.perf_counter()
         limit = float(time_limit) if time_limit is not None else math.inf
-        self.dive_limit = 0.1 * limit if math.isfinite(limit) else 30.0
-        self.elim_limit = 0.1 * limit if math.isfinite(limit) else 30.0  # labelling arc bounds
-        self.primal_limit = min(primal_share * limit, PRIMAL_CAP_S)
+        self.dive_limit = opts.dive_share * limit if math.isfinite(limit) else 30.0
+        self.elim_limit = opts.elim_share * limit if math.isfinite(limit) else 30.0  # labelling arc bounds
+        self.primal_limit = min(opts.primal_share * limit, opts.primal_cap_s)
         self.dived = False
         self.dive_starts: set[int] = set()  # first route fixed by each dive so far
-        self.grow_until = self.t0 + (grow_share * limit if math.isfinite(limit) else math.inf)
-        self.cut_until = self.t0 + (cut_share * limit if math.isfinite(limit) else math.inf)
+        self.grow_until = self.t0 + (opts.grow_share * limit if math.isfinite(limit) else math.inf)
+        self.cut_until = self.t0 + (opts.cut_share * limit if math.isfinite(limit) else math.inf)
         self.hard_deadline = self.t0 + limit
         self.reserve = min(5.0, 0.1 * limit)  # kept for a last MILP over the generated routes
         self.deadline = self.hard_deadline - self.reserve
@@ -150,12 +130,13 @@ class BranchAndPrice:
         self.reachable[1 : self.V + 1] = trip <= self.budget
         self.master = Master(self.V, instance.prizes, instance.groups, self.N)
         n = self.V + 2
-        self.ng = full_ng(n) if ng_size >= self.V else nearest_ng(self.cost, ng_size)
+        self.ng = full_ng(n) if opts.ng_size >= self.V else nearest_ng(self.cost, opts.ng_size)
         self.stats = _Stats()
         self.incumbent_value = 0.0 if not instance.groups else -math.inf
         self.incumbent: list[tuple[int, ...]] | None = [] if not instance.groups else None
+        initial_routes = warm_start.routes if warm_start is not None else ()
         cols = [(int(p),) for p in np.flatnonzero(self.reachable)]
-        for r in initial_routes or ():
+        for r in initial_routes:
             pts = tuple(int(v) + 1 for v in r)
             if pts and self._energy(pts) <= self.budget:
                 cols.append(pts)
@@ -431,7 +412,7 @@ class BranchAndPrice:
     # -- primal heuristics -----------------------------------------------------------------
     def _call_primal(self) -> None:
         """Run the caller's heuristic (``primal``) once, with ``primal_share`` of the time limit
-        (at most ``PRIMAL_CAP_S``): its plan becomes columns and, if the verifier passes it and
+        (at most ``primal_cap_s``): its plan becomes columns and, if the verifier passes it and
         it is better, the incumbent. Called when the root's floored bound is settled and the
         first dive has not found a plan that proves it, so instances the root or its first dive
         settle (most TOP instances) never pay for it."""
@@ -597,7 +578,7 @@ class BranchAndPrice:
         arcs the DP leaves (exact ng-labelling both ways, about as costly as two exact pricing
         calls, much tighter). The labelling bound only covers the paths above its threshold, so
         it stays valid as the incumbent, and with it the floor, rises. Its forward search also
-        yields the ``POOL_ROUTES`` best elementary routes that a better plan may use; they join
+        yields the ``pool_routes`` best elementary routes that a better plan may use; they join
         the master as columns, so that the MILP over the generated routes can combine them."""
         floor = self._rc_floor()
         if floor is None:
@@ -614,7 +595,7 @@ class BranchAndPrice:
                 cost[through - y[0] < floor] = np.inf
                 exact = label_arc_bounds(cost, prof, allowed, self.budget, self.ng, y[0] + floor,
                                          deadline=min(self.deadline, t + self.elim_limit),
-                                         n_routes=POOL_ROUTES)
+                                         n_routes=self.options.pool_routes)
                 if exact is not None:
                     through = np.minimum(through, exact[0])
                     # the same search's best routes: near-optimal columns for the MILP
@@ -694,7 +675,7 @@ class BranchAndPrice:
                 break
             if self._prunable(bound):
                 continue
-            if self.stats.nodes % 4 == 0 and self._time_left() > 0:
+            if self.stats.nodes % self.options.dive_every == 0 and self._time_left() > 0:
                 # dive again from this node (other fixings than the root's dive)
                 self.dive(min(0.3 * self.dive_limit, 0.25 * self._time_left()), start=state)
                 self.master.apply(state)
@@ -712,7 +693,7 @@ class BranchAndPrice:
             for ch in children:
                 heapq.heappush(heap, self._node_key(bound, ch.depth, counter, ch))
                 counter += 1
-            if self.stats.nodes % 10 == 0 and self.master.n_routes > last_milp_cols:
+            if self.stats.nodes % self.options.milp_every == 0 and self.master.n_routes > last_milp_cols:
                 self._run_milp(min(5.0, 0.1 * max(self._time_left(), 0.0)))
                 last_milp_cols = self.master.n_routes
         else:
@@ -733,32 +714,24 @@ class BranchAndPrice:
 
 
 def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
-             initial_routes=None, ng_size: int = 8, bidirectional: bool | None = None,
-             ng_columns: bool = True, ng_cap: int = 12, grow_share: float = 0.3,
-             cut_rounds: int | None = None, cuts_per_round: int = 16, cut_gap: float | None = None,
-             cut_share: float = 0.35, primal=None, primal_share: float = PRIMAL_SHARE,
-             strong: int = STRONG) -> Result:
+             warm_start: Plan | None = None, primal=None, options: BPOptions | None = None) -> Result:
     """Branch-and-price: proven optimum, or the best plan and a certified bound at the limit.
 
-    ``initial_routes`` (node ids, e.g. a heuristic plan's routes) are added as starting columns
-    and as a first incumbent. ``primal(seconds) -> routes or None`` (node ids) is a heuristic
-    run once if the root does not settle the proof, with ``primal_share`` of the time limit (at
-    most ``PRIMAL_CAP_S``); its routes become columns and, if verified and better, the
-    incumbent. ``bidirectional``: exact pricing direction; None picks the faster one on the
-    first exact pricing call. ``seed`` is unused (no randomness; timing-based choices
-    and the time limit can still change the path taken).
+    ``warm_start``: a plan (e.g. a heuristic's) whose routes are added as starting columns and
+    as a first incumbent. ``primal(seconds) -> routes or None`` (node ids) is a heuristic run
+    once if the root does not settle the proof, with ``options.primal_share`` of the time limit
+    (at most ``options.primal_cap_s``); its routes become columns and, if verified and better,
+    the incumbent. ``options``: None means :meth:`BPOptions.for_time_limit` of ``time_limit``.
+    ``seed`` is unused (no randomness; timing-based choices and the time limit can still change
+    the path taken).
     """
     warm_up()  # JIT compilation (cached on disk after the first run) is not charged to the limit
     t0 = time.perf_counter()
     reason = precheck(instance)
     if reason is not None:
         return Result("bp", Status.INFEASIBLE, reason=reason, runtime_s=time.perf_counter() - t0)
-    bp = BranchAndPrice(instance, time_limit=time_limit, ng_size=ng_size,
-                        initial_routes=initial_routes, bidirectional=bidirectional,
-                        ng_columns=ng_columns, ng_cap=ng_cap, grow_share=grow_share,
-                        cut_rounds=cut_rounds, cuts_per_round=cuts_per_round, cut_gap=cut_gap,
-                        cut_share=cut_share, primal=primal, primal_share=primal_share,
-                        strong=strong)
+    bp = BranchAndPrice(instance, time_limit=time_limit, warm_start=warm_start, primal=primal,
+                        options=options)
     proven, bound = bp.run()
     st = bp.stats
     info = {
