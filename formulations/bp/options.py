@@ -101,6 +101,7 @@ class BPOptions:
         ``time_limit``."""
         return replace(
             self,
-            cut_rounds=default_cut_rounds(time_limit) if self.cut_rounds is None else self.cut_rounds,
+            cut_rounds=(default_cut_rounds(time_limit) if self.cut_rounds is None
+                        else self.cut_rounds),
             cut_gap=default_cut_gap(time_limit) if self.cut_gap is None else self.cut_gap)
 
