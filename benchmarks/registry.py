@@ -101,20 +101,14 @@ def cpsat(instance, *, seed=0, time_limit=60.0) -> Result:
 
 
 def bp(instance, *, seed=0, time_limit=60.0) -> Result:
-    from sarcover.formulations.bp import default_cut_gap, default_cut_rounds, solve_bp
+    from sarcover.formulations.bp import BPOptions, solve_bp
     from sarcover.formulations.bp.pricing import warm_up
     from sarcover.heuristics.pyvrp_ils import primal_routes
 
     warm_up()  # numba compilation (or loading it from the disk cache) is not the method's time
-
-    def solve(instance, *, seed, time_limit, warm_start, **options):
-        routes = [list(r) for r in warm_start.routes] if warm_start is not None else None
-        return solve_bp(instance, seed=seed, time_limit=time_limit, initial_routes=routes, **options)
-
-    # cuts from the user's limit (on from 60 s), not from what greedy leaves of it
-    return warm_started(solve, instance, seed=seed, time_limit=time_limit,
-                        cut_rounds=default_cut_rounds(time_limit), cut_gap=default_cut_gap(time_limit),
-                        primal=primal_routes(instance, seed))
+    # options from the user's limit (cuts on from 60 s), not from what greedy leaves of it
+    return warm_started(solve_bp, instance, seed=seed, time_limit=time_limit,
+                        options=BPOptions.for_time_limit(time_limit), primal=primal_routes(instance, seed))
 
 
 # numba code compiled before a benchmark's workers start (see :func:`warm_up`)

@@ -12,9 +12,11 @@ import numpy as np
 import pytest
 
 from sarcover.benchmarks.registry import run_method
-from sarcover.formulations.bp import solve_bp
+from sarcover.formulations.bp import BPOptions, solve_bp
+from sarcover.formulations.bp.options import CUTS_FROM_S, OPEN_CUTS_FROM_S
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.io import load_instance
+from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Status
 from sarcover.formulations.verify import route_energy, verify
 
@@ -113,7 +115,7 @@ def test_groups_force_lower_prize():
 def test_initial_routes_are_used():
     """A warm-start plan is accepted as incumbent and the proof still reaches the optimum."""
     inst = load_instance(TOP_DIR / "p2.2.d.txt")
-    res = solve_bp(inst, time_limit=30, initial_routes=[[0], [1]])
+    res = solve_bp(inst, time_limit=30, warm_start=Plan.of([[0], [1]]))
     assert res.status == Status.OPTIMAL and res.bound == OPTIMAL["p2.2.d"]
 
 
@@ -393,7 +395,7 @@ def test_ng_route_columns_count_visits():
     being ng-routes when the ng sets grow are excluded from the master."""
     from sarcover.formulations.bp.master import Master
     from sarcover.formulations.bp.pricing import add_to_ng, nearest_ng
-    from sarcover.formulations.bp.branch_price import NodeState
+    from sarcover.formulations.bp.node import NodeState
 
     m = Master(4, np.ones(4), [(0, 1)], 2)
     m.add_routes([(1, 2, 3, 1), (1, 2), (3, 4)])
@@ -413,7 +415,7 @@ def test_branching_decisions_exclude_exactly_the_conflicting_routes():
     """Master.incompatible against its definition, route by route (repeated visits included):
     a route is out iff it visits a forbidden point, uses a forbidden arc, or leaves the tail of a
     forced arc (not the start) or enters its head (not the end) by another arc."""
-    from sarcover.formulations.bp.branch_price import NodeState
+    from sarcover.formulations.bp.node import NodeState
     from sarcover.formulations.bp.master import Master
 
     rng = np.random.default_rng(3)
@@ -454,13 +456,14 @@ def test_branching_decisions_exclude_exactly_the_conflicting_routes():
 def test_targeted_slack_keeps_the_floor(value, n):
     """The raised exact-pricing threshold: dual value + N * (slack + TOL) stays below the next
     integer (or incumbent + 1), so 'nothing found above the threshold' settles floor(bound)."""
-    from sarcover.formulations.bp.branch_price import TOL, BranchAndPrice
+    from sarcover.formulations.bp.search import TOL
+    from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = TOPInstance(coords=[[1, 0]], prizes=[1], start=[0, 0], end=[0, 0], budget=5.0, n_vehicles=n)
     bp = BranchAndPrice(inst, time_limit=10)
     for inc in (None, int(value) - 2, int(value) + 1):
-        bp.incumbent, bp.incumbent_value = (None, -np.inf) if inc is None else ([], float(inc))
-        slack = bp._slack(value)
+        bp.search.incumbent, bp.search.incumbent_value = (None, -np.inf) if inc is None else ([], float(inc))
+        slack = bp.colgen.slack(value)
         target = max(np.floor(value + 1e-6) + 1, (inc if inc is not None else -np.inf) + 1)
         assert slack >= 0
         if slack > 0:
@@ -472,17 +475,19 @@ def test_dive_gives_a_verified_plan(seed):
     """The diving heuristic (root LP, then fixing routes) only returns plans the verifier accepts,
     never better than enumeration; on these tiny instances it finds the enumerated optimum
     whenever a plan exists."""
-    from sarcover.formulations.bp.branch_price import BranchAndPrice, NodeState
+    from sarcover.formulations.bp.node import NodeState
+    from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = random_tiny(seed, groups=True)
     best = brute_force(inst)
     bp = BranchAndPrice(inst, time_limit=20)
-    bp.column_generation(NodeState(), np.inf)
-    bp.dive(5.0)
+    bp.colgen.solve(NodeState(), np.inf)
+    bp.incumbents.dive(5.0)
+    s = bp.search
     if best is None:
-        assert bp.incumbent is None
+        assert s.incumbent is None
     else:
-        assert bp.incumbent is not None and bp.incumbent_value == pytest.approx(best)
+        assert s.incumbent is not None and s.incumbent_value == pytest.approx(best)
 
 
 def test_registered_bp_starts_from_greedy():
@@ -574,60 +579,66 @@ def test_milp_column_filter_keeps_every_better_plan(name):
     """The reduced-cost filter of the MILP's columns (duals that certified the root bound)
     never removes a better plan: with the incumbent set below the best plan over the generated
     routes, the filtered MILP finds a plan of that same value, from fewer routes."""
-    from sarcover.formulations.bp.branch_price import BranchAndPrice, NodeState
+    from sarcover.formulations.bp.node import NodeState
+    from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = _top(name)
     bp = BranchAndPrice(inst, time_limit=30)
-    bp.column_generation(NodeState(), np.inf)
-    assert bp.root_cert is not None
-    full = bp.master.milp(20.0)
-    best = sum(bp.master.route_prize[bp.master.routes.index(r)] for r in full)
-    for below in (bp.step, 2 * bp.step, 4 * bp.step):
-        bp.incumbent, bp.incumbent_value = [], best - below
-        keep = bp._milp_columns()
-        assert keep is not None and keep.sum() <= bp.master.n_routes
-        got = bp.master.milp(20.0, keep)
+    s, m = bp.search, bp.search.master
+    bp.colgen.solve(NodeState(), np.inf)
+    assert bp.elimination.cert is not None
+    full = m.milp(20.0)
+    best = sum(m.route_prize[m.routes.index(r)] for r in full)
+    for below in (s.step, 2 * s.step, 4 * s.step):
+        s.incumbent, s.incumbent_value = [], best - below
+        keep = bp.elimination.milp_columns()
+        assert keep is not None and keep.sum() <= m.n_routes
+        got = m.milp(20.0, keep)
         assert got is not None
-        assert sum(bp.master.route_prize[bp.master.routes.index(r)] for r in got) == pytest.approx(best)
-    bp.incumbent_value = best  # nothing better among these routes: the filter may keep none,
-    keep = bp._milp_columns()  # and whatever it keeps cannot beat the incumbent by a step
-    sub = bp.master.milp(20.0, keep) if keep.any() else []
-    assert sum(bp.master.route_prize[bp.master.routes.index(r)] for r in sub or []) <= best + 1e-9
+        assert sum(m.route_prize[m.routes.index(r)] for r in got) == pytest.approx(best)
+    s.incumbent_value = best  # nothing better among these routes: the filter may keep none,
+    keep = bp.elimination.milp_columns()  # and whatever it keeps cannot beat the incumbent by a step
+    sub = m.milp(20.0, keep) if keep.any() else []
+    assert sum(m.route_prize[m.routes.index(r)] for r in sub or []) <= best + 1e-9
 
 
 def test_strong_branching_proves_the_same_optimum():
     """Strong branching (children estimated on the current columns) changes which candidate is
     branched on, never the result: p3.3.o is proven at its published optimum either way, only
     the strong run pays for estimates, and the master's bounds are the node's again after them."""
-    from sarcover.formulations.bp.branch_price import BranchAndPrice, NodeState
+    from sarcover.formulations.bp.branching import branch, branch_candidates
+    from sarcover.formulations.bp.node import NodeState
+    from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = _top("p3.3.o")
-    results = {st: solve_bp(inst, time_limit=30, strong=st) for st in (1, 5)}
+    results = {st: solve_bp(inst, time_limit=30, options=BPOptions(strong=st)) for st in (1, 5)}
     for st, r in results.items():
         assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p3.3.o"])
         assert verify(inst, r.plan).valid
         assert (r.info["strong_lps"] > 0) == (st > 1)
     bp = BranchAndPrice(inst, time_limit=30)
-    _, x, _, _ = bp.column_generation(NodeState(), np.inf)
-    cands = bp._branch_candidates(NodeState(), x)
+    m = bp.search.master
+    _, x, _, _ = bp.colgen.solve(NodeState(), np.inf)
+    cands = branch_candidates(bp.search, NodeState(), x)
     assert len(cands) > 1
-    before = bp.master.col_ub.copy()
-    lp = float(np.dot(bp.master.route_prize, x[: bp.master.n_routes]))
-    pick = bp._branch(NodeState(), x, lp)
-    assert pick in cands[: bp.strong]
-    assert np.array_equal(bp.master.col_ub, before)
+    before = m.col_ub.copy()
+    lp = float(np.dot(m.route_prize, x[: m.n_routes]))
+    pick = branch(bp.search, NodeState(), x, lp, bp.options.strong)
+    assert pick in cands[: bp.options.strong]
+    assert np.array_equal(m.col_ub, before)
 
 
 def test_milp_start_plan_is_a_floor():
     """The MILP takes a plan as its first solution: with only that plan's routes allowed it
     returns that plan, under any time limit it returns nothing worse, and a start that is not
     made of generated routes is ignored (p2.2.k)."""
-    from sarcover.formulations.bp.branch_price import BranchAndPrice, NodeState
+    from sarcover.formulations.bp.node import NodeState
+    from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = _top("p2.2.k")
     bp = BranchAndPrice(inst, time_limit=30)
-    bp.column_generation(NodeState(), np.inf)
-    m = bp.master
+    bp.colgen.solve(NodeState(), np.inf)
+    m = bp.search.master
     value = lambda routes: sum(m.route_prize[m.routes.index(r)] for r in routes)  # noqa: E731
     best = m.milp(20.0)
     start = sorted(best, key=len)[1:]  # a worse plan: the best without its shortest route
@@ -770,7 +781,8 @@ def test_purging_cuts_keeps_the_published_optimum():
     """Rounds of 48 cuts on p2.2.k pass the 64-cut limit, so idle cuts are purged between
     rounds; the published optimum is still proven."""
     inst = load_instance(TOP_DIR / "p2.2.k.txt")
-    r = solve_bp(inst, time_limit=60, cut_rounds=4, cuts_per_round=48, cut_gap=100.0, cut_share=1.0)
+    r = solve_bp(inst, time_limit=60, options=BPOptions(cut_rounds=4, cuts_per_round=48, cut_gap=100.0,
+                                                    cut_share=1.0))
     assert r.info["cuts_purged"] > 0
     assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p2.2.k"])
     assert r.bound == pytest.approx(OPTIMAL["p2.2.k"])
@@ -781,7 +793,7 @@ def test_cuts_keep_the_published_optimum(name):
     """With subset-row cuts forced on (these files get 8 to 38 cuts at the root), bp still proves
     exactly the published optimum with a verified plan."""
     inst = load_instance(TOP_DIR / f"{name}.txt")
-    r = solve_bp(inst, time_limit=60, cut_rounds=4, cut_gap=100.0, cut_share=1.0)
+    r = solve_bp(inst, time_limit=60, options=BPOptions(cut_rounds=4, cut_gap=100.0, cut_share=1.0))
     assert r.info["cuts"] > 0
     assert r.status == Status.OPTIMAL
     assert sum(inst.prizes[v] for v in r.plan.visited) == pytest.approx(OPTIMAL[name])
@@ -793,7 +805,7 @@ def test_cuts_match_brute_force(seed):
     """Tiny random instances with groups, cuts forced on: same optimum as enumeration."""
     inst = random_tiny(seed, groups=True)
     best = brute_force(inst)
-    r = solve_bp(inst, time_limit=30, cut_rounds=4, cut_gap=100.0, cut_share=1.0)
+    r = solve_bp(inst, time_limit=30, options=BPOptions(cut_rounds=4, cut_gap=100.0, cut_share=1.0))
     if best is None:
         assert r.status == Status.INFEASIBLE
     else:
@@ -808,13 +820,13 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, thre
     open their gate is, follow the user's time limit (at CUTS_FROM_S: on; at OPEN_CUTS_FROM_S:
     open), not the slightly smaller one left for solve_bp."""
     import sarcover.formulations.bp as bp_package
-    import sarcover.formulations.bp.branch_price as branch_price
+    import sarcover.formulations.bp.options as bp_options
     from sarcover.benchmarks.registry import METHODS
-    from sarcover.formulations.bp.branch_price import (CUTS_FROM_S, OPEN_CUTS_FROM_S, default_cut_gap,
-                                              default_cut_rounds)
+    from sarcover.formulations.bp.options import (CUTS_FROM_S, OPEN_CUTS_FROM_S, default_cut_gap,
+                                                  default_cut_rounds)
     from sarcover.formulations.result import Result, Termination
 
-    limit = getattr(branch_price, threshold) + offset
+    limit = getattr(bp_options, threshold) + offset
     seen = {}
 
     def fake_solve_bp(instance, **kw):
@@ -824,33 +836,63 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, thre
     monkeypatch.setattr(bp_package, "solve_bp", fake_solve_bp)
     METHODS["bp"].run(random_tiny(0, groups=False), time_limit=limit)
     assert seen["time_limit"] < limit
-    assert seen["cut_rounds"] == default_cut_rounds(limit) == (6 if limit >= CUTS_FROM_S else 0)
-    assert seen["cut_gap"] == default_cut_gap(limit) == (1.0 if limit >= OPEN_CUTS_FROM_S else 0.5)
+    assert seen["options"].cut_rounds == default_cut_rounds(limit) == (6 if limit >= CUTS_FROM_S else 0)
+    assert seen["options"].cut_gap == default_cut_gap(limit) == (1.0 if limit >= OPEN_CUTS_FROM_S else 0.5)
 
 
 def test_cuts_are_on_by_default_for_long_runs_only():
     """Cuts slow pricing down; by default they are used from CUTS_FROM_S seconds (and without a
     limit) and can be forced either way."""
-    from sarcover.formulations.bp.branch_price import CUTS_FROM_S, BranchAndPrice
+    from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = random_tiny(0, groups=False)
-    assert BranchAndPrice(inst, time_limit=CUTS_FROM_S - 1).cut_rounds == 0
-    assert BranchAndPrice(inst, time_limit=CUTS_FROM_S).cut_rounds > 0
-    assert BranchAndPrice(inst, time_limit=None).cut_rounds > 0
-    assert BranchAndPrice(inst, time_limit=None, cut_rounds=0).cut_rounds == 0
-    assert BranchAndPrice(inst, time_limit=10, cut_rounds=2).cut_rounds == 2
+    assert BranchAndPrice(inst, time_limit=CUTS_FROM_S - 1).cuts.rounds == 0
+    assert BranchAndPrice(inst, time_limit=CUTS_FROM_S).cuts.rounds > 0
+    assert BranchAndPrice(inst, time_limit=None).cuts.rounds > 0
+    assert BranchAndPrice(inst, time_limit=None, options=BPOptions(cut_rounds=0)).cuts.rounds == 0
+    assert BranchAndPrice(inst, time_limit=10, options=BPOptions(cut_rounds=2)).cuts.rounds == 2
 
 
 def test_cut_gate_opens_for_long_runs():
     """Below OPEN_CUTS_FROM_S a cut round needs the root LP within half a step of a useful drop;
     from it (and without a limit) the gate is open; an explicit cut_gap wins."""
-    from sarcover.formulations.bp.branch_price import OPEN_CUTS_FROM_S, BranchAndPrice
+    from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = random_tiny(0, groups=False)
-    assert BranchAndPrice(inst, time_limit=OPEN_CUTS_FROM_S - 1).cut_gap == 0.5
-    assert BranchAndPrice(inst, time_limit=OPEN_CUTS_FROM_S).cut_gap == 1.0
-    assert BranchAndPrice(inst, time_limit=None).cut_gap == 1.0
-    assert BranchAndPrice(inst, time_limit=None, cut_gap=0.25).cut_gap == 0.25
+    assert BranchAndPrice(inst, time_limit=OPEN_CUTS_FROM_S - 1).cuts.gap == 0.5
+    assert BranchAndPrice(inst, time_limit=OPEN_CUTS_FROM_S).cuts.gap == 1.0
+    assert BranchAndPrice(inst, time_limit=None).cuts.gap == 1.0
+    assert BranchAndPrice(inst, time_limit=None, options=BPOptions(cut_gap=0.25)).cuts.gap == 0.25
+
+
+@pytest.mark.parametrize("limit", [CUTS_FROM_S - 1, CUTS_FROM_S, OPEN_CUTS_FROM_S - 1,
+                                   OPEN_CUTS_FROM_S, None])
+def test_options_for_time_limit(limit):
+    """BPOptions.for_time_limit: the defaults, with the cut settings decided on the limit (cuts
+    on from CUTS_FROM_S, their gate open from OPEN_CUTS_FROM_S); options that leave them None
+    get the same from the solve's own limit; the options are frozen."""
+    import dataclasses
+
+    opts = BPOptions.for_time_limit(limit)
+    on, open_gate = limit is None or limit >= CUTS_FROM_S, limit is None or limit >= OPEN_CUTS_FROM_S
+    assert opts.cut_rounds == (6 if on else 0) and opts.cut_gap == (1.0 if open_gate else 0.5)
+    assert dataclasses.replace(opts, cut_rounds=None, cut_gap=None) == BPOptions()
+    assert BPOptions().with_limit_defaults(limit) == opts
+    assert BPOptions(cut_rounds=2, strong=1).with_limit_defaults(limit).cut_rounds == 2
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        opts.strong = 1
+
+
+def test_solve_bp_options_override_a_default():
+    """At 30 s cuts are off by default; options=BPOptions(...) turns them on for the same call
+    (and the published optimum is proven either way)."""
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    default = solve_bp(inst, time_limit=30)
+    forced = solve_bp(inst, time_limit=30,
+                      options=BPOptions(cut_rounds=4, cut_gap=100.0, cut_share=1.0))
+    assert default.info["cuts"] == 0 and forced.info["cuts"] > 0
+    for r in (default, forced):
+        assert r.status == Status.OPTIMAL and r.bound == pytest.approx(OPTIMAL["p2.2.k"])
 
 
 def _arcs_of_plans_from(inst: TOPInstance, value: float) -> set:
@@ -871,43 +913,47 @@ def _arcs_of_plans_from(inst: TOPInstance, value: float) -> set:
 def test_arc_elimination_keeps_every_better_plan(seed):
     """With the incumbent one step below the optimum, reduced-cost arc elimination after the
     root LP (DP and labelling bounds) removes arcs, but none of any optimal plan (enumerated)."""
-    from sarcover.formulations.bp.branch_price import BranchAndPrice, NodeState
+    from sarcover.formulations.bp.node import NodeState
+    from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = random_tiny(seed, groups=False)
     best = brute_force(inst)
-    bp = BranchAndPrice(inst, time_limit=None, strong=1)
-    bp.dived = True  # no dive: it could find the optimum and move the floor above it
-    bp.incumbent, bp.incumbent_value = [], best - bp.step
-    bp.column_generation(NodeState(), math.inf)
-    bp._eliminate_arcs(labels=True)
-    gone = {(int(a), int(b)) for a, b in zip(*np.nonzero(bp.master.eliminated))}
-    assert gone and bp.stats.elim_labels
+    bp = BranchAndPrice(inst, time_limit=None, options=BPOptions(strong=1))
+    s = bp.search
+    bp.incumbents.dived = True  # no dive: it could find the optimum and move the floor above it
+    s.incumbent, s.incumbent_value = [], best - s.step
+    bp.colgen.solve(NodeState(), math.inf)
+    bp.elimination.eliminate(labels=True)
+    gone = {(int(a), int(b)) for a, b in zip(*np.nonzero(s.master.eliminated))}
+    assert gone and s.stats.elim_labels
     assert not gone & _arcs_of_plans_from(inst, best)
 
 
 def test_labelling_arc_bounds_run_before_the_first_cut_round():
     """With cuts on, the root's labelling arc elimination runs before any cut is separated, so
     the cut rounds price on the smaller graph; the published optimum is still proven."""
-    from sarcover.formulations.bp.branch_price import BranchAndPrice
+    from sarcover.formulations.bp.tree import BranchAndPrice
 
     events = []
-
-    class Recording(BranchAndPrice):
-        def _eliminate_arcs(self, labels=False):
-            before = self.stats.arcs_eliminated
-            super()._eliminate_arcs(labels)
-            if labels:
-                events.append(("labels", self.stats.arcs_eliminated - before))
-
-        def _add_cuts(self, state, x, y, lp_value):
-            cuts = self.stats.cuts
-            out = super()._add_cuts(state, x, y, lp_value)
-            if self.stats.cuts > cuts:
-                events.append(("cuts", self.stats.cuts - cuts))
-            return out
-
     inst = load_instance(TOP_DIR / "p2.2.k.txt")
-    bp = Recording(inst, time_limit=60, cut_rounds=4, cut_gap=100.0, cut_share=1.0)
+    bp = BranchAndPrice(inst, time_limit=60,
+                        options=BPOptions(cut_rounds=4, cut_gap=100.0, cut_share=1.0))
+    stats, eliminate, add_cuts = bp.search.stats, bp.elimination.eliminate, bp.cuts.add
+
+    def recording_eliminate(labels=False):
+        before = stats.arcs_eliminated
+        eliminate(labels)
+        if labels:
+            events.append(("labels", stats.arcs_eliminated - before))
+
+    def recording_add_cuts(state, x, y, lp_value):
+        cuts = stats.cuts
+        out = add_cuts(state, x, y, lp_value)
+        if stats.cuts > cuts:
+            events.append(("cuts", stats.cuts - cuts))
+        return out
+
+    bp.elimination.eliminate, bp.cuts.add = recording_eliminate, recording_add_cuts
     proven, bound = bp.run()
     kinds = [k for k, _ in events]
     assert "cuts" in kinds and "labels" in kinds
@@ -920,18 +966,20 @@ def test_root_out_of_time_right_after_the_route_pool_joined():
     the time runs out right then (no re-solve, no dive), the root's LP solution must still match
     the master's columns. It used not to (a ValueError at M = 20, K = 6 in loaded runs); now the
     run stops with a valid bound."""
-    from sarcover.formulations.bp.branch_price import BranchAndPrice
-
-    class OutOfTime(BranchAndPrice):
-        def _eliminate_arcs(self, labels=False):
-            before = self.master.n_routes
-            super()._eliminate_arcs(labels)
-            if labels:
-                self.pool_added = self.master.n_routes - before
-                self.deadline = self.hard_deadline = time.perf_counter() - 1.0
+    from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = load_instance(TOP_DIR / "p2.2.k.txt")
-    bp = OutOfTime(inst, time_limit=60, cut_rounds=0)
+    bp = BranchAndPrice(inst, time_limit=60, options=BPOptions(cut_rounds=0))
+    s, eliminate, pool_added = bp.search, bp.elimination.eliminate, []
+
+    def out_of_time(labels=False):
+        before = s.master.n_routes
+        eliminate(labels)
+        if labels:
+            pool_added.append(s.master.n_routes - before)
+            s.deadline = s.hard_deadline = time.perf_counter() - 1.0
+
+    bp.elimination.eliminate = out_of_time
     proven, bound = bp.run()
-    assert bp.pool_added > 0  # the pool did add columns after the root LP
+    assert pool_added[-1] > 0  # the pool did add columns after the root LP
     assert not proven and bound >= OPTIMAL["p2.2.k"] - 1e-6

@@ -1,0 +1,184 @@
+"""Column generation at one branch-and-bound node.
+
+Each round solves the restricted master LP and prices:
+
+1. heuristic pricing (dominance without remembered sets) until it finds no improving route;
+2. exact pricing over ng-routes (a relaxation of elementary routes): its best reduced prize gives
+   the certified Lagrangian bound of the round. Improving routes become columns, elementary or
+   not: an ng-route that repeats a point enters the master with visit-count coefficients, so it
+   is never part of an integer solution but keeps the LP the ng-route relaxation that the pricing
+   bounds exactly;
+3. targeted exact pricing (below the root): with integer prizes a bound only matters rounded
+   down to the prize lattice, so the exact call's threshold is raised to what N routes may add
+   without reaching the next lattice point that matters (:meth:`ColumnGeneration.slack`); when
+   nothing beats it the node's floored bound is settled and the node is pruned or branched on
+   at once, without converging the LP's tail. The root's LP is converged, because converged
+   duals make the arc elimination much stronger;
+4. dynamic ng sets: when the LP solution uses a route that repeats a point u, u is remembered at
+   the points of its cycle (up to ``ng_cap`` points), the routes that stop being ng-routes leave
+   the master, and column generation goes on with the stronger relaxation; only within the first
+   ``grow_share`` of the time limit, since larger ng sets make pricing slower.
+
+At the root, once the floored bound is settled, the first dive (and if needed the caller's
+heuristic) runs before the ng sets grow, and the cut rounds (:mod:`.cuts`) come last.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from sarcover.formulations.bp.node import NodeState, node_graph
+from sarcover.formulations.bp.pricing import add_to_ng
+from sarcover.formulations.bp.search import TOL
+
+if TYPE_CHECKING:
+    from sarcover.formulations.bp.cuts import CutRounds
+    from sarcover.formulations.bp.elimination import Elimination
+    from sarcover.formulations.bp.incumbent import IncumbentSearch
+    from sarcover.formulations.bp.pricer import Pricer
+    from sarcover.formulations.bp.search import Search
+
+
+class ColumnGeneration:
+    """Solves nodes' LPs for one run (:meth:`solve`); ng sets grow up to ``ng_cap`` points until
+    ``grow_until`` (a :func:`time.perf_counter` moment)."""
+
+    def __init__(self, search: "Search", pricer: "Pricer", elimination: "Elimination",
+                 incumbents: "IncumbentSearch", cuts: "CutRounds", *, ng_cap: int,
+                 grow_until: float):
+        self.search = search
+        self.pricer = pricer
+        self.elimination = elimination
+        self.incumbents = incumbents
+        self.cuts = cuts
+        self.ng_cap = ng_cap
+        self.grow_until = grow_until
+
+    def solve(self, state: NodeState, bound: float):
+        """Solve one node's LP by column generation, starting from the parent's ``bound``.
+        Returns (bound, x, x_art, converged); not converged: out of time, or an exact pricing
+        hit its label cap."""
+        s, m, pricer, elim = self.search, self.search.master, self.pricer, self.elimination
+        version = None
+        arcs_decided = bool(state.forbidden_arcs or state.forced_arcs)
+        x = xa = None
+        while True:
+            if version != elim.version:  # first round, or more arcs eliminated since
+                version = elim.version
+                m.apply(state)
+                cost, ret, allowed_base = node_graph(s, state)
+                arcs_decided = arcs_decided or version > 0
+            t = time.perf_counter()
+            value, x, xa, y = m.solve()
+            s.stats.lp_s += time.perf_counter() - t
+            s.stats.rounds += 1
+            if s.time_left() <= 0:
+                return bound, x, xa, False
+            prof = m.point_profit(y)
+            sig = m.cut_duals(y)
+            allowed = allowed_base.copy()
+            if not arcs_decided:
+                # With the triangle inequality a node of reduced prize <= 0 can be skipped.
+                allowed &= prof > 1e-12
+            y0 = float(y[0])
+            res = pricer.price(cost, ret, prof, allowed, heuristic=True, y0=y0, sig=sig)
+            if m.add_routes(pricer.columns(res)):
+                continue
+            if s.time_left() <= 0:
+                return bound, x, xa, False
+            gain = y0 + (self.slack(m.lagrangian_bound(y, y0)) if state.depth else 0.0)
+            res = pricer.exact(cost, ret, prof, allowed, gain, sig)
+            s.stats.exact_pricings += 1
+            if res.exact:
+                lag = m.lagrangian_bound(y, res.best)
+                if state.depth == 0:
+                    # duals that certify the root bound: they eliminate arcs and MILP columns
+                    elim.root_duals(y, y0, res.best, lag)
+                bound = min(bound, lag)
+                if state.depth == 0:
+                    s.log(bound)
+                if s.prunable(bound):
+                    return bound, x, xa, True  # pruned (at the root: proven) before convergence
+            if m.add_routes(pricer.columns(res)):
+                continue
+            if res.best - gain > TOL and res.cycles:
+                for cyc in res.cycles:  # cycle u ... u: remember u at every node of the cycle
+                    u = cyc[0]
+                    for w in cyc[1:-1]:
+                        add_to_ng(s.ng, w, u)
+                s.stats.ng_growths += 1
+                continue
+            if not res.exact:
+                return bound, x, xa, False
+            if state.depth == 0 and not self.incumbents.dived and s.time_left() > 0:
+                # the root's floored bound is settled: find a plan before growing ng sets
+                # (which only pays when the incumbent is below the floored bound)
+                self._first_dive(state, bound)
+                if s.prunable(bound):
+                    return bound, x, xa, True
+                continue  # re-solve with the heuristic's and the dive's columns
+            if self._grow_ng_from_lp(x):
+                m.apply(state)
+                continue
+            if self.cuts.add(state, x, y, value):
+                continue
+            return bound, x, xa, True
+
+    def _first_dive(self, state: NodeState, bound: float) -> None:
+        """The root's first dive; if it leaves the proof open, the caller's heuristic, and a
+        second dive over its columns. Leaves the master at the root node."""
+        s, inc = self.search, self.incumbents
+        inc.dived = True
+        inc.dive(min(inc.dive_limit, 0.5 * s.time_left()))
+        if not s.prunable(bound) and inc.primal is not None:
+            inc.call_primal()
+            if not s.prunable(bound):  # dive again, now with the heuristic's columns
+                s.master.apply(state)  # (its LP differs: any start route, even the first's)
+                inc.dive(min(inc.dive_limit, 0.5 * s.time_left()), fresh=True)
+        s.master.apply(state)
+
+    def slack(self, dual_value: float) -> float:
+        """Targeted pricing: how much the best route's reduced prize may exceed the vehicle dual
+        while dual_value + N·excess stays below the next value that matters: the next lattice
+        point above dual_value, or incumbent + step if higher (integer prizes only)."""
+        s = self.search
+        if not s.integral:
+            return 0.0
+        target = s.floor(dual_value) + s.step
+        if s.incumbent is not None:
+            target = max(target, s.incumbent_value + s.step)
+        # reported best >= y0 + slack + TOL, so keep N·TOL and the floor's 1e-6 below target
+        return max(0.0, (target - dual_value - 2e-6) / s.N - 2 * TOL)
+
+    def _grow_ng_from_lp(self, x) -> bool:
+        """Dynamic ng sets: for every repeated route in the LP solution, remember the repeated
+        point along its cycle (ng sets capped at ``ng_cap``), exclude the routes that stop being
+        ng-routes, and report whether anything changed (the LP is then re-solved)."""
+        s = self.search
+        m = s.master
+        if time.perf_counter() > self.grow_until:
+            return False  # growing makes pricing slower: past this point, branching decides
+        grown = False
+        for r in m.repeated:
+            if x[r] <= TOL or r in m.dead:
+                continue
+            path = m.routes[r]
+            last = {}
+            for pos, u in enumerate(path):
+                if u in last:
+                    for w in path[last[u] + 1 : pos]:
+                        if not (s.ng[w, u >> 6] >> np.uint64(u & 63)) & np.uint64(1) and \
+                                self._ng_size(w) < self.ng_cap:
+                            add_to_ng(s.ng, w, u)
+                            grown = True
+                last[u] = pos
+        if grown:
+            s.stats.ng_growths += 1
+            m.kill_non_ng(s.ng)
+        return grown
+
+    def _ng_size(self, w: int) -> int:
+        return int(sum(bin(int(word)).count("1") for word in self.search.ng[w]))

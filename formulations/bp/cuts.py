@@ -1,0 +1,72 @@
+"""Rounds of limited-memory subset-row cuts at the root (the rows themselves: :mod:`.master`).
+
+Cuts make every later pricing slower (labels carry cut parities, pay their duals and dominate
+less), so a round is only tried at the root, once its floored bound is settled and the ng sets
+stop growing, within the first ``cut_share`` of the time limit, and while the restricted LP is
+less than ``cut_gap`` prize steps above the value that would prove the incumbent optimal or above
+its own floor: a small drop then lowers the floored bound; larger drops are rare, and branching
+does better. At most :data:`.master.MAX_CUTS` at a time: when a round would pass that, the cuts
+of zero dual are removed first.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING
+
+from sarcover.formulations.bp.master import MAX_CUTS
+from sarcover.formulations.bp.node import NodeState
+
+if TYPE_CHECKING:
+    from sarcover.formulations.bp.elimination import Elimination
+    from sarcover.formulations.bp.search import Search
+
+
+class CutRounds:
+    """Up to ``rounds`` rounds of the ``per_round`` most violated triples, gated by ``gap``
+    (prize steps) and started before ``until`` (a :func:`time.perf_counter` moment)."""
+
+    def __init__(self, search: "Search", elimination: "Elimination", *, rounds: int,
+                 per_round: int, gap: float, until: float):
+        self.search = search
+        self.elimination = elimination
+        self.rounds = rounds
+        self.per_round = per_round
+        self.gap = gap
+        self.until = until
+        self.done = 0  # rounds separated so far
+        self.labelled = False  # the labelling arc bounds ran before the first round
+
+    def add(self, state: NodeState, x, y, lp_value: float) -> bool:
+        """Separate cuts violated by the node's LP solution ``x`` (duals ``y``, value
+        ``lp_value``); report whether the LP changed (cuts added, or the graph or the columns
+        changed by the labelling arc bounds run before the first round), so that it is
+        re-solved."""
+        s = self.search
+        if state.depth > 0 or self.done >= self.rounds or s.time_left() <= 0:
+            return False
+        if s.incumbent is None or time.perf_counter() > self.until:
+            return False
+        if s.stats.root_lp is None:
+            s.stats.root_lp = lp_value
+        # the drop that proves the incumbent optimal, or lowers the floored bound by one step
+        need = min(lp_value - (s.incumbent_value + s.step), lp_value - s.floor(lp_value))
+        if need > self.gap * s.step:
+            return False
+        if not self.labelled:
+            # the labelling arc bounds first: cut rounds then price on the smaller graph
+            self.labelled = True
+            version, k = self.elimination.version, s.master.n_routes
+            self.elimination.eliminate(labels=True)
+            if self.elimination.version != version or s.master.n_routes != k:
+                return True  # re-solve (smaller graph, the route pool), then separate
+        self.done += 1
+        m = s.master
+        if len(m.cuts) + self.per_round > MAX_CUTS:  # make room: drop idle cuts
+            purged = m.purge_cuts(y)
+            s.stats.cuts_purged += purged
+            if purged:
+                self.elimination.forget()  # its duals refer to rows that are gone
+        added = m.add_cuts(m.separate_cuts(x, self.per_round))
+        s.stats.cuts += added
+        return added > 0

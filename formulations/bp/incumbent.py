@@ -1,0 +1,169 @@
+"""Incumbent search: every plan found anywhere goes through :meth:`IncumbentSearch.offer` (the
+verifier decides); plans come from dives, from a MILP over the generated routes, from the
+caller's ``primal`` heuristic and from integral LP solutions.
+
+The column-generation routes alone are poor material for the MILP; the dives' routes fit
+together (they are priced with earlier routes fixed), and so do the caller's heuristic plan and
+the labelling's best routes (:mod:`.elimination`). Proves nothing: the bound is the search's.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from sarcover.formulations.bp.node import NodeState, node_graph
+from sarcover.formulations.bp.search import TOL
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.verify import verify
+
+if TYPE_CHECKING:
+    from sarcover.formulations.bp.elimination import Elimination
+    from sarcover.formulations.bp.pricer import Pricer
+    from sarcover.formulations.bp.search import Search
+
+
+class IncumbentSearch:
+    """Incumbents of one run. ``primal(seconds) -> routes or None`` (node ids): the caller's
+    heuristic, run at most once with ``primal_limit`` seconds; ``dive_limit``: seconds for a dive
+    at the root (later dives get less)."""
+
+    def __init__(self, search: "Search", pricer: "Pricer", elimination: "Elimination", primal,
+                 *, dive_limit: float, primal_limit: float):
+        self.search = search
+        self.pricer = pricer
+        self.elimination = elimination
+        self.primal = primal
+        self.dive_limit = dive_limit
+        self.primal_limit = primal_limit
+        self.dived = False  # the root's first dive has run
+        self.dive_starts: set[int] = set()  # first route fixed by each dive so far
+
+    def offer(self, routes):
+        """Accept a plan (solver points) as incumbent if the verifier agrees and it is better
+        (a better incumbent eliminates more arcs). Returns the verifier's report (None for no
+        plan or more than N routes)."""
+        s = self.search
+        if routes is None or len(routes) > s.N:
+            return None
+        plan = Plan.of([[p - 1 for p in r] for r in routes])
+        rep = verify(s.inst, plan)
+        if rep.valid and rep.prize > s.incumbent_value + 1e-9:
+            s.incumbent_value = rep.prize
+            s.incumbent = list(routes)
+            s.log()
+            self.elimination.eliminate()
+        return rep
+
+    def offer_if_integral(self, x, xa) -> bool:
+        """Offer the LP solution's routes if it is integral (no artificials); report whether."""
+        if xa.max() <= TOL and np.all(np.abs(x - np.round(x)) <= TOL):
+            m = self.search.master
+            self.offer([m.routes[r] for r in np.flatnonzero(x > 0.5)])
+            return True
+        return False
+
+    def run_milp(self, limit: float) -> None:
+        """The best plan over the generated routes (HiGHS, started from the incumbent), within
+        ``limit`` seconds, over the routes that can be part of a better plan."""
+        s = self.search
+        s.stats.milp_calls += 1
+        limit = min(limit, max(0.0, s.hard_deadline - time.perf_counter() - 0.1))
+        if limit > 0.05:
+            t, before = time.perf_counter(), s.incumbent_value
+            allowed = self.elimination.milp_columns()
+            if allowed is not None:
+                s.stats.milp_columns = int(allowed.sum())
+                if not allowed.any():
+                    return  # no generated route can be part of a better plan
+            self.offer(s.master.milp(limit, allowed, start=s.incumbent))
+            s.stats.milp_s += time.perf_counter() - t
+            s.stats.milp_improved += s.incumbent_value > before
+
+    def call_primal(self) -> None:
+        """Run the caller's heuristic (``primal``) once: its plan becomes columns and, if the
+        verifier passes it and it is better, the incumbent. Called when the root's floored bound
+        is settled and the first dive has not found a plan that proves it, so instances the root
+        or its first dive settle (most TOP instances) never pay for it."""
+        s = self.search
+        if self.primal is None or s.time_left() <= 0:
+            return
+        t = time.perf_counter()
+        allowance = min(self.primal_limit, 0.5 * s.time_left())
+        try:
+            routes = self.primal(allowance)
+        except Exception as exc:  # a failing heuristic must not cost the proof search
+            s.stats.primal_error = f"{type(exc).__name__}: {exc}"
+            routes = None
+        s.stats.primal_s = round(time.perf_counter() - t, 3)
+        if not routes:
+            return
+        pts = [tuple(int(v) + 1 for v in r) for r in routes if len(r)]
+        before = s.incumbent_value
+        rep = self.offer(pts)
+        s.stats.primal_prize = float(rep.prize) if rep is not None and rep.valid else None
+        s.stats.primal_improved = s.incumbent_value > before
+        s.master.add_routes([r for r in pts if s.energy(r) <= s.budget])
+
+    def dive(self, limit: float, start: NodeState | None = None, *, fresh: bool = False) -> None:
+        """Diving: fix the route of largest LP value (its nodes and arcs forced), re-solve the
+        LP with heuristic pricing only, repeat until the LP solution is integral. A fixing that
+        leaves the LP infeasible is undone and the next route tried (at most 3 times). Feeds
+        incumbents and columns (routes that fit together) to the MILP. The first route fixed is
+        one no earlier dive started from, unless ``fresh`` (the LP has new columns, as after the
+        primal heuristic). Leaves the master's bounds at the dive's last node: the caller
+        applies its own node again."""
+        s = self.search
+        m = s.master
+        m.hide_repeated = True  # plans are made of elementary routes: ng-routes would only mislead
+        before = s.incumbent_value
+        try:
+            self._dive(limit, start, fresh)
+        finally:
+            m.hide_repeated = False
+        s.stats.dives += 1
+        s.stats.dive_improved += s.incumbent_value > before
+
+    def _dive(self, limit: float, start: NodeState | None, fresh: bool) -> None:
+        s = self.search
+        m = s.master
+        stop = min(s.deadline, time.perf_counter() + limit)
+        state, parent = (start or NodeState()), None
+        used: set[int] = set()  # routes fixed or tried: never picked again
+        failures = 0
+        while time.perf_counter() < stop:
+            m.apply(state)
+            cost, ret, allowed = node_graph(s, state)
+            for _ in range(200):
+                value, x, xa, y = m.solve()
+                self.offer_if_integral(x, xa)
+                if time.perf_counter() >= stop:
+                    break
+                res = self.pricer.price(cost, ret, m.point_profit(y), allowed, heuristic=True,
+                                        y0=float(y[0]), sig=m.cut_duals(y))
+                if not m.add_routes(res.routes):
+                    break
+            if xa.max() > TOL:  # the fixings cannot be completed (as far as heuristic pricing sees)
+                failures += 1
+                if parent is None or failures > 3:
+                    break
+                state, parent = parent, None
+                continue
+            pos = np.flatnonzero(x > TOL)
+            if np.all(np.abs(x[pos] - np.round(x[pos])) <= TOL):
+                self.offer([m.routes[r] for r in np.flatnonzero(x > 0.5)])
+                break
+            cand = [r for r in pos if r not in used]
+            if not used and not fresh:  # first fixing: not where a previous dive started
+                cand = [r for r in cand if r not in self.dive_starts] or cand
+            if not cand:
+                break
+            r = max(cand, key=lambda k: x[k])
+            if not used:
+                self.dive_starts.add(r)
+            used.add(r)
+            full = [0, *m.routes[r], s.V + 1]
+            parent = state
+            state = state.child(forced_nodes=m.routes[r], forced_arcs=list(zip(full, full[1:])))

@@ -1,0 +1,64 @@
+"""A branch-and-bound node: its branching decisions, and the pricing graph they leave.
+
+Both kinds of decision keep the pricing a plain labelling on a modified graph: a forbidden node
+leaves the graph, a forced node only changes its master row (``= 1``); a forbidden arc is removed,
+a forced arc (a, b) removes every other arc out of a and into b.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from sarcover.formulations.bp.pricing import cheapest_return
+
+if TYPE_CHECKING:
+    from sarcover.formulations.bp.search import Search
+
+
+@dataclass(frozen=True)
+class NodeState:
+    """Branching decisions of one branch-and-bound node (solver points: node id + 1)."""
+
+    forbidden_nodes: frozenset = frozenset()
+    forced_nodes: frozenset = frozenset()
+    forbidden_arcs: frozenset = frozenset()
+    forced_arcs: frozenset = frozenset()
+    depth: int = 0
+
+    def child(self, **add) -> "NodeState":
+        kw = {k: getattr(self, k) | frozenset(add.get(k, ())) for k in
+              ("forbidden_nodes", "forced_nodes", "forbidden_arcs", "forced_arcs")}
+        return NodeState(**kw, depth=self.depth + 1)
+
+
+def node_graph(search: "Search", state: NodeState):
+    """The pricing graph at a node: (arc costs with the removed arcs at inf, cheapest energy to
+    the end from each point, allowed points). Eliminated arcs (:mod:`.elimination`) are removed
+    too, and a point whose every incoming arc is gone is no longer allowed."""
+    cost = search.cost.copy()
+    n = search.V + 2
+    end = n - 1
+    for a, b in state.forbidden_arcs:
+        cost[a, b] = np.inf
+    for a, b in state.forced_arcs:
+        if a != 0:
+            keep = cost[a, b]
+            cost[a, :] = np.inf
+            cost[a, b] = keep
+        if b != end:
+            keep = cost[a, b]
+            cost[:, b] = np.inf
+            cost[a, b] = keep
+    allowed = search.reachable.copy()
+    for p in state.forbidden_nodes:
+        allowed[p] = False
+    eliminated = search.master.eliminated
+    if eliminated.any():
+        cost[eliminated] = np.inf
+        into = np.isfinite(cost)
+        np.fill_diagonal(into, False)
+        allowed &= into.any(axis=0)
+    return cost, cheapest_return(cost), allowed

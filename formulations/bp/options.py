@@ -1,0 +1,107 @@
+"""The branch-and-price's tunable settings (:class:`BPOptions`), and the defaults that follow
+the user's time limit.
+
+Subset-row cuts make every pricing call after them slower, so they only pay back on long runs:
+they are on from ``CUTS_FROM_S``, and from ``OPEN_CUTS_FROM_S`` they are tried however far the
+root LP is from a drop that matters. A caller that spends part of the user's limit before
+:func:`~sarcover.formulations.bp.solve_bp` (the registered ``bp`` runs greedy first) decides
+them on the user's limit with :meth:`BPOptions.for_time_limit`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+CUTS_FROM_S = 60.0  # time limits from which subset-row cuts are on by default
+OPEN_CUTS_FROM_S = 300.0  # ... and from which they are tried however far the LP is from a drop
+
+
+def default_cut_rounds(time_limit: float | None) -> int:
+    """Rounds of subset-row cuts by default: 6 from ``CUTS_FROM_S`` (and without a limit),
+    else 0."""
+    return 6 if time_limit is None or float(time_limit) >= CUTS_FROM_S else 0
+
+
+def default_cut_gap(time_limit: float | None) -> float:
+    """How close (in prize steps) the restricted root LP must be to a drop that matters (below
+    the incumbent + one step, or below its own floor) for a cut round: 0.5 below
+    ``OPEN_CUTS_FROM_S``, 1.0 from it (and without a limit), which is no gate at all since an LP
+    value is always less than one step above its floor."""
+    return 1.0 if time_limit is None or float(time_limit) >= OPEN_CUTS_FROM_S else 0.5
+
+
+@dataclass(frozen=True)
+class BPOptions:
+    """Settings of one branch-and-price run. Shares are fractions of the time limit.
+
+    Pricing and the ng-route relaxation:
+
+    - ``ng_size``: starting ng set of a point: itself and its ``ng_size - 1`` cheapest
+      neighbours (all points, i.e. elementary pricing, when it reaches the number of nodes).
+    - ``bidirectional``: exact pricing direction (True: bidirectional labelling, False: one-way);
+      None: the first exact call runs both and keeps the faster.
+    - ``ng_columns``: improving ng-routes that repeat a point also enter the master (with
+      visit counts), so that the LP stays the relaxation that the pricing bounds.
+    - ``ng_cap``: the most points an ng set grows to when LP routes repeat a point.
+    - ``grow_share``: ng sets only grow within this share of the limit (larger sets make pricing
+      slower; after that, branching decides).
+
+    Subset-row cuts (at the root only):
+
+    - ``cut_rounds``: rounds of cuts; 0 turns them off; None: by the time limit
+      (:func:`default_cut_rounds`).
+    - ``cuts_per_round``: most violated triples added per round.
+    - ``cut_gap``: a round is only tried while the restricted LP is within this many prize steps
+      of a drop that matters; None: by the time limit (:func:`default_cut_gap`).
+    - ``cut_share``: rounds only start within this share of the limit.
+
+    Incumbents and branching:
+
+    - ``primal_share``, ``primal_cap_s``: time for the caller's ``primal`` heuristic (run once,
+      if the root and its first dive leave the proof open), at most ``primal_cap_s`` seconds.
+    - ``dive_share``: time for a dive at the root (30 s without a limit); later dives get less.
+    - ``dive_every``, ``milp_every``: a dive every this many nodes, a MILP over the generated
+      routes every this many nodes (when new routes came in).
+    - ``strong``: branching candidates compared by their children's restricted LPs (1: the most
+      fractional candidate, no estimates).
+
+    Arc elimination:
+
+    - ``elim_share``: time for the exact labelling arc bounds (30 s without a limit).
+    - ``pool_routes``: best elementary routes of that labelling that join the master as columns
+      (for the MILP over the generated routes).
+    """
+
+    ng_size: int = 8
+    bidirectional: bool | None = None
+    ng_columns: bool = True
+    ng_cap: int = 12
+    grow_share: float = 0.3
+    cut_rounds: int | None = None
+    cuts_per_round: int = 16
+    cut_gap: float | None = None
+    cut_share: float = 0.35
+    primal_share: float = 0.1
+    primal_cap_s: float = 10.0
+    dive_share: float = 0.1
+    dive_every: int = 4
+    milp_every: int = 10
+    strong: int = 5
+    elim_share: float = 0.1
+    pool_routes: int = 2000
+
+    @classmethod
+    def for_time_limit(cls, time_limit: float | None) -> "BPOptions":
+        """The default options for a run whose user asked for ``time_limit`` seconds (None: no
+        limit): cuts on from ``CUTS_FROM_S``, their gate open from ``OPEN_CUTS_FROM_S``."""
+        return cls().with_limit_defaults(time_limit)
+
+    def with_limit_defaults(self, time_limit: float | None) -> "BPOptions":
+        """These options with the settings left None (``cut_rounds``, ``cut_gap``) decided on
+        ``time_limit``."""
+        return replace(
+            self,
+            cut_rounds=(default_cut_rounds(time_limit) if self.cut_rounds is None
+                        else self.cut_rounds),
+            cut_gap=default_cut_gap(time_limit) if self.cut_gap is None else self.cut_gap)
+

@@ -1,0 +1,69 @@
+"""The labelling (:func:`.pricing.price`) as the search calls it: heuristic or exact, against a
+threshold, with the subset-row cuts' duals, timed and counted; and the choice of the exact
+pricing's direction."""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING
+
+from sarcover.formulations.bp.pricing import price
+from sarcover.formulations.bp.search import TOL
+
+if TYPE_CHECKING:
+    from sarcover.formulations.bp.search import Search
+
+
+class Pricer:
+    """Pricing calls of one run. ``bidirectional``: the exact pricing direction; None until the
+    first exact call has measured both."""
+
+    def __init__(self, search: "Search", bidirectional: bool | None, ng_columns: bool):
+        self.search = search
+        self.bidirectional = bidirectional
+        self.ng_columns = ng_columns
+
+    def price(self, cost, ret, prof, allowed, *, heuristic: bool, y0: float, sig,
+              deadline: float | None = None):
+        """One labelling call on a node's graph (:func:`.node.node_graph`) with reduced prizes
+        ``prof``; ``y0`` is the threshold a path's reduced prize must beat (the vehicle dual, or
+        more for a targeted exact call); ``sig``: the subset-row cuts' duals."""
+        s = self.search
+        t = time.perf_counter()
+        res = price(cost, ret, prof, s.budget, s.ng, allowed, heuristic=heuristic,
+                    max_labels=200_000 if heuristic else 2_000_000,
+                    n_cols=30 if heuristic else 60, min_gain=y0 + TOL,
+                    deadline=s.deadline if deadline is None else deadline,
+                    bidirectional=bool(self.bidirectional) and not heuristic,
+                    cut_members=s.master.cut_members, cut_memory=s.master.cut_memory,
+                    cut_duals=sig)
+        s.stats.pricing_s += time.perf_counter() - t
+        s.stats.labels += res.n_labels
+        return res
+
+    def exact(self, cost, ret, prof, allowed, y0: float, sig):
+        """Exact pricing. On the first call both searches run, the bidirectional one under the
+        one-way search's time; the faster is kept for the rest of the run (neither dominates:
+        bidirectional wins on long routes with many labels, loses when the join is large)."""
+        if self.bidirectional is not None:
+            return self.price(cost, ret, prof, allowed, heuristic=False, y0=y0, sig=sig)
+        t = time.perf_counter()
+        self.bidirectional = False
+        uni = self.price(cost, ret, prof, allowed, heuristic=False, y0=y0, sig=sig)
+        t_uni = time.perf_counter() - t
+        if not uni.exact:
+            return uni
+        deadline = min(self.search.deadline, time.perf_counter() + 0.8 * t_uni)
+        t = time.perf_counter()
+        self.bidirectional = True
+        bi = self.price(cost, ret, prof, allowed, heuristic=False, y0=y0, sig=sig,
+                        deadline=deadline)
+        t_bi = time.perf_counter() - t
+        self.search.stats.mode_times = (round(t_uni, 4), round(t_bi, 4))
+        self.bidirectional = bool(bi.exact) and t_bi < 0.8 * t_uni
+        return uni
+
+    def columns(self, res) -> list:
+        """The improving routes of a pricing result that join the master: the elementary ones,
+        and the ng-routes that repeat a point unless ``ng_columns`` is off."""
+        return list(res.routes) + (list(res.ng_routes) if self.ng_columns else [])

@@ -1,0 +1,63 @@
+"""What one branch-and-price run counts and reports (``Result.info``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+@dataclass
+class Stats:
+    """Counters and timings of one run; :meth:`info` is what ``Result.info`` reports."""
+
+    rounds: int = 0
+    exact_pricings: int = 0
+    labels: int = 0
+    ng_growths: int = 0
+    nodes: int = 0
+    milp_calls: int = 0
+    milp_s: float = 0.0
+    strong_lps: int = 0
+    strong_s: float = 0.0
+    open_nodes: int = 0  # nodes left unsolved at the limit (0 when proven)
+    milp_improved: int = 0  # MILP calls that raised the incumbent
+    milp_columns: int | None = None  # routes the last MILP could use (reduced-cost filter)
+    dives: int = 0
+    dive_improved: int = 0  # dives that raised the incumbent
+    primal_s: float | None = None  # the caller's heuristic: time, its plan's prize, improved?
+    primal_prize: float | None = None
+    primal_improved: bool | None = None
+    primal_error: str | None = None
+    cuts: int = 0
+    cuts_purged: int = 0
+    arcs_eliminated: int = 0  # arcs no plan better than the incumbent can use
+    elim_s: float = 0.0  # time spent on their bounds
+    elim_labels: bool | None = None  # the labelling bound ran to the end (None: not tried)
+    pool_routes: int = 0  # routes its search added to the master
+    root_lp: float | None = None  # restricted root LP value when cuts were first considered
+    pricing_s: float = 0.0
+    lp_s: float = 0.0
+    root_bound: float | None = None
+    root_s: float | None = None
+    mode_times: tuple | None = None  # first exact pricing: (one-way s, bidirectional s)
+    history: list = field(default_factory=list)  # (time, incumbent, bound)
+
+    def info(self, *, columns: int, bidirectional: bool | None) -> dict:
+        """The run's ``Result.info``: these counters (times rounded to ms), the master's number
+        of ``columns`` and the exact pricing direction that was kept."""
+        return {
+            "nodes": self.nodes, "rounds": self.rounds, "columns": columns,
+            "exact_pricings": self.exact_pricings, "labels": self.labels,
+            "ng_growths": self.ng_growths, "milp_calls": self.milp_calls,
+            "milp_s": round(self.milp_s, 3), "milp_improved": self.milp_improved,
+            "milp_columns": self.milp_columns, "dives": self.dives,
+            "dive_improved": self.dive_improved, "strong_lps": self.strong_lps,
+            "strong_s": round(self.strong_s, 3), "open_nodes": self.open_nodes,
+            "cuts": self.cuts, "cuts_purged": self.cuts_purged,
+            "arcs_eliminated": self.arcs_eliminated, "elim_s": round(self.elim_s, 3),
+            "elim_labels": self.elim_labels, "pool_routes": self.pool_routes,
+            "root_lp": self.root_lp, "primal_s": self.primal_s, "primal_prize": self.primal_prize,
+            "primal_improved": self.primal_improved, "primal_error": self.primal_error,
+            "pricing_s": round(self.pricing_s, 3), "lp_s": round(self.lp_s, 3),
+            "root_bound": self.root_bound, "root_s": self.root_s, "history": self.history,
+            "threads": 1, "bidirectional": bidirectional, "mode_times": self.mode_times,
+        }
