@@ -221,9 +221,9 @@ def _markdown(tab: pd.DataFrame, verdicts: pd.DataFrame, df: pd.DataFrame, headi
         allv = verdicts[(verdicts["setting"] == "all settings") & (verdicts["other"] == other)]
         if len(allv):
             v = allv.iloc[0]
-            name = "DPC" if other == "dpc" else "KMeans"
-            says = {"less": f"yes: ADPC's clustering loses less than {name}'s",
-                    "more": f"no: ADPC's clustering loses more than {name}'s",
+            name, poss = ("DPC", "DPC's") if other == "dpc" else ("KMeans", "KMeans'")
+            says = {"less": f"yes: ADPC's clustering loses less than {poss}",
+                    "more": f"no: ADPC's clustering loses more than {poss}",
                     "no clear difference": f"not shown: ADPC's and {name}'s clustering losses do not differ "
                                            "beyond noise",
                     "too few": "too few instances to say"}[v["verdict"]]
