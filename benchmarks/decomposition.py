@@ -216,7 +216,8 @@ def cases_from_results(results_dir: str | Path, *, exact=("bp", "milp", "cpsat")
     rows, _ = read_rows(results_dir)
     by_instance: dict[str, list[dict]] = {}
     for r in rows:
-        by_instance.setdefault(r["instance"], []).append(r)
+        if (r.get("source") or {}).get("type") == "generate":  # random SAR sets (M, K, N known)
+            by_instance.setdefault(r["instance"], []).append(r)
     cases = []
     for name, group in sorted(by_instance.items()):
         ex = [r for r in group if r["method"] in exact]
