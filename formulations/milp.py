@@ -58,6 +58,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 import pyomo.environ as pyo
@@ -407,6 +408,8 @@ def solve_milp(
     cliques: bool = True,
     paths: bool = True,
     tee: bool = False,
+    graph: ArcGraph | None = None,
+    extend: Callable[[pyo.ConcreteModel, ArcGraph], None] | None = None,
 ) -> Result:
     """Solve ``instance`` exactly with HiGHS (see the module docstring for the method).
 
@@ -414,6 +417,12 @@ def solve_milp(
     method, :mod:`sarcover.benchmarks.registry`, passes greedy's plan).
     ``root_rounds``: rounds of LP connectivity-cut separation before the MIP (0 turns it off).
     Terminates OPTIMAL only when the verified plan reaches HiGHS's proven bound.
+
+    ``graph`` and ``extend`` solve a restriction of the problem with the same loop (the clustered
+    optimum of :mod:`sarcover.formulations.clustered` does): ``graph`` is a subset of
+    :func:`~sarcover.formulations.preprocess.prune_arcs`'s arcs, ``extend(model, graph)`` adds
+    constraints after :func:`build_milp`. Every bound is then a bound of the restricted problem,
+    and ``warm_start`` must be a plan of it (the caller checks).
     """
     t0 = time.perf_counter()
     deadline = None if time_limit is None else t0 + float(time_limit)
@@ -432,12 +441,14 @@ def solve_milp(
     reason = precheck(instance)
     if reason is not None:
         return done(Termination.INFEASIBLE, reason=reason)
-    g = prune_arcs(instance)
+    g = prune_arcs(instance) if graph is None else graph
     info.update(nodes=len(g.nodes), arcs=len(g.arcs), arcs_full=g.n_arcs_full)
     if not g.nodes:  # nothing reachable; precheck passed, so there are no groups
         return done(Termination.OPTIMAL, plan=Plan.of([]), bound=0.0, reason="no node is reachable within the budget")
     lattice = prize_lattice(instance.prizes[[i - 1 for i in g.nodes]])
     m = build_milp(instance, g, two_cycle=two_cycle, cliques=cliques, paths=paths)
+    if extend is not None:
+        extend(m, g)
 
     opt = SolverFactory("highs")
     options = {

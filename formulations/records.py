@@ -136,3 +136,20 @@ def read_rows(directory: str | Path) -> tuple[list[dict], dict[str, int]]:
             seen.add(row["key"])
             rows.append(row)
     return rows, skipped
+
+
+def read_decomposition(path: str | Path) -> list[dict]:
+    """The rows of a decomposition file (:mod:`sarcover.benchmarks.decomposition` writes one JSON
+    object per instance, method and seed; the reports read them); a half-written line is skipped."""
+    path = Path(path)
+    if not path.is_file():
+        return []
+    rows = []
+    for line in path.read_text().splitlines():
+        try:
+            row = json.loads(line)
+        except ValueError:
+            continue
+        if isinstance(row, dict) and "instance" in row and "method" in row:
+            rows.append(row)
+    return rows

@@ -132,3 +132,61 @@ def test_expired_time_limit_still_gives_a_verified_plan(name):
     result = run_method(name, inst, seed=0, time_limit=1e-9)
     assert result.status == Status.FEASIBLE and result.report.valid
     assert result.info["stopped_by_time"] is True
+
+
+# ---------------------------------------------------------------- the stages apart (decomposition)
+
+from sarcover.heuristics.pipeline import (  # noqa: E402
+    ROUTERS, cluster_stage, cluster_then_route, outside_clusters, route_clusters,
+)
+
+STAGE_CASES = [(20, 3, 5, 0), (20, 6, 5, 1), (20, 3, 2, 2), (8, 2, 4, 3)]
+
+
+@pytest.mark.parametrize("clusterer", ["adpc", "dpc", "kmeans"])
+def test_cluster_stage_partitions_the_reachable_viewpoints(clusterer):
+    """N disjoint clusters, one per UAV, whose union is exactly the reachable viewpoints."""
+    for m, k, n, s in STAGE_CASES + [(3, 1, 5, 4)]:  # the last: fewer viewpoints than UAVs
+        inst = to_top(generate(m, k, n, seed=s))
+        clusters = cluster_stage(inst, clusterer, seed=s)
+        assert len(clusters) == n
+        flat = np.concatenate(clusters)
+        assert flat.size == np.unique(flat).size
+        assert sorted(flat.tolist()) == np.flatnonzero(inst.reachable()).tolist()
+
+
+@pytest.mark.parametrize("clusterer,router", [("adpc", "pso"), ("dpc", "pso"), ("kmeans", "pso"),
+                                              ("adpc", "ga"), ("adpc", "aco")])
+def test_stages_apart_give_the_pipelines_plan(clusterer, router):
+    """cluster_stage + route_clusters with one seed is the pipeline's plan, route for route, and the
+    pipeline's info keeps the clusters and which plan nodes lie outside their route's cluster."""
+    for m, k, n, s in STAGE_CASES:
+        inst = to_top(generate(m, k, n, seed=s))
+        whole = cluster_then_route(inst, clusterer, router, seed=s + 1)
+        clusters = cluster_stage(inst, clusterer, seed=s + 1)
+        apart = route_clusters(inst, clusters, router, seed=s + 1)
+        assert whole.status == apart.status == Status.FEASIBLE
+        assert whole.plan == apart.plan
+        assert whole.info["clusters"] == [c.tolist() for c in clusters]
+        outside = whole.info["outside_cluster"]
+        assert outside == outside_clusters(whole.plan.routes, clusters)
+        for i, route in enumerate(whole.plan.routes):
+            assert set(route) - set(outside[i]) <= set(clusters[i].tolist())
+            assert set(outside[i]).isdisjoint(clusters[i].tolist())
+
+
+def test_route_clusters_keeps_route_i_for_cluster_i():
+    """Given clusters in any order, route i serves cluster i (up to what repair moves)."""
+    inst = to_top(generate(20, 3, 5, seed=3))
+    clusters = cluster_stage(inst, "adpc", seed=0)[::-1]
+    result = route_clusters(inst, clusters, "pso", seed=0)
+    assert result.status == Status.FEASIBLE and verify(inst, result.plan).valid
+    for i, route in enumerate(result.plan.routes):
+        inside = [v for v in route if v not in result.info["outside_cluster"][i]]
+        assert set(inside) <= set(clusters[i].tolist())
+        assert len(inside) > 0  # each route keeps part of its own cluster here
+    with pytest.raises(ValueError, match="overlap"):
+        route_clusters(inst, [clusters[0], clusters[0]], "pso")
+    with pytest.raises(ValueError, match="clusters for"):
+        route_clusters(inst, [[0]] * 6, "pso")
+    assert set(ROUTERS) == {"pso", "ga", "aco"}

@@ -1,0 +1,161 @@
+"""The gap decomposition (benchmarks/decomposition.py): exact sums, signs, verified plans, resume."""
+
+from __future__ import annotations
+
+import io
+import json
+
+import numpy as np
+import pytest
+
+from sarcover.benchmarks.decomposition import (
+    METHODS, Case, cases_from_instances, cases_from_results, decompose, plan_clusters, read_decomposition,
+)
+from sarcover.formulations.clustered import inside, solve_clustered
+from sarcover.formulations.generate import generate
+from sarcover.formulations.instance import to_top
+from sarcover.formulations.plan import Plan
+from sarcover.formulations.result import Status
+from sarcover.formulations.verify import verify
+from sarcover.heuristics.pipeline import cluster_stage, route_clusters
+
+from test_clustered import brute_clustered
+
+
+@pytest.fixture(scope="module")
+def small_rows(tmp_path_factory):
+    """Every method (paper and oracle) on three small instances, OPT from milp."""
+    instances = [(f"m8k2n3s{s}", to_top(generate(8, 2, 3, seed=s)), {"M": 8, "K": 2, "N": 3, "instance_seed": s})
+                 for s in range(3)]
+    cases = cases_from_instances(instances, opt_method="milp", time_limit=120, stream=None)
+    assert len(cases) == 3 and all(c.opt_proven for c in cases)
+    path = tmp_path_factory.mktemp("decomp") / "rows.jsonl"
+    return cases, decompose(cases, path, seeds=(0, 1), stream=None), path
+
+
+def test_losses_sum_to_the_gap_and_have_their_signs(small_rows):
+    """For every row: the method's plan passes the verifier and has the row's objective;
+    clustering + cross-cluster + routing = OPT − objective exactly; OPT|C <= OPT; clustering and
+    routing loss >= 0; the cross-cluster part is 0 when the plan stays inside its clusters, and
+    then the routing loss is OPT|C − objective."""
+    cases, rows, _ = small_rows
+    by_name = {c.name: c for c in cases}
+    assert len(rows) == 3 * len(METHODS) * 2
+    moved = 0
+    for r in rows:
+        case = by_name[r["instance"]]
+        assert r["status"] == "feasible", r
+        rep = verify(case.instance, Plan.of(r["routes"]))
+        assert rep.valid and rep.prize == r["objective"]
+        assert r["opt_c_proven"] and r["opt_cp_proven"]
+        total = r["clustering_loss"] + r["cross_cluster"] + r["routing_loss"]
+        assert total == r["gap"] == r["opt"] - r["objective"]
+        assert r["opt_c"] <= r["opt"] + 1e-9
+        assert r["clustering_loss"] >= 0 and r["routing_loss"] >= 0
+        if r["n_outside"] == 0:
+            assert r["cross_cluster"] == 0 and r["routing_loss"] == r["opt_c"] - r["objective"]
+            assert inside(Plan.of(r["routes"]), r["clusters"])
+        else:
+            moved += 1
+            assert inside(Plan.of(r["routes"]), r["clusters_plan"])
+        if r["clusterer"] == "oracle":
+            assert r["opt_c"] == r["opt"] and r["clustering_loss"] == 0
+    assert moved > 0  # the refill does move viewpoints across clusters here: that branch is tested
+
+
+def test_opt_c_of_the_rows_is_brute_force(small_rows):
+    """The rows' OPT|C for the paper clusterings equals brute force on the smallest instance."""
+    cases, rows, _ = small_rows
+    inst = to_top(generate(3, 2, 2, seed=0, e_max=3500.0))
+    for clusterer in ("adpc", "dpc", "kmeans"):
+        clusters = cluster_stage(inst, clusterer, seed=0)
+        res = solve_clustered(inst, clusters, time_limit=60)
+        expected = brute_clustered(inst, clusters)
+        if expected is None:
+            assert res.status == Status.INFEASIBLE
+        else:
+            assert res.status == Status.OPTIMAL and verify(inst, res.plan).prize == expected
+    clusters = {(r["instance"], r["clusterer"]): r["opt_c"] for r in rows if r["clusterer"] != "oracle"}
+    for r in rows:  # one clustering per clusterer (ADPC and DPC are deterministic; KMeans per seed)
+        if r["clusterer"] in ("adpc", "dpc"):
+            assert r["opt_c"] == clusters[(r["instance"], r["clusterer"])]
+
+
+def test_plans_inside_their_clusters_lose_nothing_to_cross_moves():
+    """Without the refill a plan mostly stays inside its clusters; those plans never beat OPT|C
+    (brute force), so their routing loss is >= 0 without a cross-cluster part."""
+    checked = 0
+    for s in range(6):
+        inst = to_top(generate(3, 2, 2, seed=s, e_max=4000.0))
+        for clusterer in ("adpc", "dpc", "kmeans"):
+            clusters = cluster_stage(inst, clusterer, seed=s)
+            res = route_clusters(inst, clusters, "pso", seed=s, reinsert=False)
+            if res.status != Status.FEASIBLE or res.info["n_outside_cluster"]:
+                continue
+            rep = verify(inst, res.plan)
+            assert rep.valid and inside(res.plan, clusters)
+            assert rep.prize <= brute_clustered(inst, clusters) + 1e-9
+            checked += 1
+    assert checked >= 5
+
+
+def test_plan_clusters_moves_visited_nodes_to_their_route():
+    clusters = [[0, 1, 2], [3, 4], []]
+    plan = Plan.of([[0, 3], [4], [1]])
+    assert plan_clusters(clusters, plan) == [[0, 2, 3], [4], [1]]
+    assert inside(plan, plan_clusters(clusters, plan))
+
+
+def test_resume_skips_stored_rows_and_survives_a_torn_line(small_rows, tmp_path):
+    """A second run adds nothing; after a torn last line the run completes the missing rows, and
+    the stored OPT|C values are reused (no new solve for a clustering already in the file)."""
+    cases, rows, path = small_rows
+    again = decompose(cases, path, seeds=(0, 1), stream=None)
+    assert len(again) == len(rows)
+    lines = path.read_text().splitlines()
+    torn = tmp_path / "torn.jsonl"
+    torn.write_text("\n".join(lines[:-2]) + "\n" + lines[-2][: len(lines[-2]) // 2])
+    assert len(read_decomposition(torn)) == len(lines) - 2
+    err = io.StringIO()
+    done = decompose(cases, torn, seeds=(0, 1), stream=err)
+    keys = [f"{r['instance']}|{r['method']}|{r['seed']}" for r in done]
+    assert len(set(keys)) == len(rows) and "2/2" in err.getvalue()
+    last = {f"{r['instance']}|{r['method']}|{r['seed']}": r for r in rows}
+    for r in done[-2:]:
+        assert r["opt_c"] == last[f"{r['instance']}|{r['method']}|{r['seed']}"]["opt_c"]
+
+
+def test_cases_from_a_results_directory(tmp_path):
+    """Cases come from a harness results directory: OPT from the proven exact row, the plan the
+    oracle clustering starts from verified; an instance without exact rows is skipped."""
+    from sarcover.benchmarks.harness import run_suite
+    from sarcover.benchmarks.suite import load_suite
+
+    suite = tmp_path / "tiny.toml"
+    suite.write_text('name = "tiny"\nmethods = ["milp", "adpc-pso"]\ntime_limit = 60\n'
+                     '[[instances]]\nM = 5\nK = 2\nN = 2\nruns = 2\n')
+    run_suite(load_suite(str(suite)), tmp_path / "res", workers=1, progress=False)
+    cases = cases_from_results(tmp_path / "res")
+    assert len(cases) == 2
+    stored = [json.loads(line) for line in (tmp_path / "res" / "results.jsonl").read_text().splitlines()]
+    for case in cases:
+        milp = next(r for r in stored if r["instance"] == case.name and r["method"] == "milp")
+        assert case.opt_proven and case.opt == milp["objective"] and case.opt_source == "milp"
+        assert verify(case.instance, case.opt_plan).prize == case.opt
+        assert case.meta["M"] == 5 and case.meta["K"] == 2
+    rows = decompose(cases, tmp_path / "d.jsonl", methods=("adpc-pso", "oracle-pso"), stream=None)
+    assert all(r["clustering_loss"] + r["cross_cluster"] + r["routing_loss"] == r["gap"] for r in rows)
+
+
+def test_unproven_opt_is_flagged(tmp_path):
+    """With a bound for OPT (not proven) the row says so; the sum still holds."""
+    inst = to_top(generate(6, 2, 2, seed=1))
+    cases = cases_from_instances([("x", inst, {})], opt_method="milp", time_limit=60, stream=None)
+    case = cases[0]
+    loose = Case("x", inst, case.opt + 3, False, case.opt_plan, "bound")
+    rows = decompose([loose], tmp_path / "rows.jsonl", methods=("adpc-pso",), stream=None)
+    r = rows[0]
+    assert r["opt_proven"] is False
+    assert r["clustering_loss"] + r["cross_cluster"] + r["routing_loss"] == r["gap"]
+    assert np.isclose(r["clustering_loss"], case.opt + 3 - r["opt_c"])
+
