@@ -371,8 +371,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _one_line(exc: Exception) -> str:
-    """The error's message on one line (a file name may hold a newline)."""
-    return " ".join(str(exc).split("\n"))
+    """The error's message on one line (a file name or an argument may hold a line break)."""
+    return " ".join(str(exc).splitlines())
 
 
 if __name__ == "__main__":

@@ -103,6 +103,10 @@ class SARInstance:
         if not np.all(np.isfinite(views)):  # a target so close to the base that H·cosθ/‖t‖ overflows
             m = int(np.flatnonzero(~np.isfinite(views).all(axis=1))[0]) // self.n_views
             raise InstanceError(f"target {m} lies too close to the base (0, 0) for its viewpoints to be computed")
+        if np.abs(views).max() > MAX_MAGNITUDE:  # a target near the limit, its views H·cosθ beyond it
+            m = int(np.flatnonzero((np.abs(views) > MAX_MAGNITUDE).any(axis=1))[0]) // self.n_views
+            raise InstanceError(f"target {m} has viewpoints beyond ±{MAX_MAGNITUDE:g} (larger numbers would "
+                                f"overflow the energy sums)")
 
     @property
     def n_targets(self) -> int:

@@ -44,7 +44,10 @@ def check_sar_size(n_targets: int, n_views: int, n_uavs: int) -> None:
 def check_magnitude(name: str, value: float) -> float:
     """``value`` if within ±MAX_MAGNITUDE, else an InstanceError naming ``name`` and the limit."""
     if not -MAX_MAGNITUDE <= value <= MAX_MAGNITUDE:
-        raise InstanceError(f"{name} is {shown(value)}, beyond ±{MAX_MAGNITUDE:g} (larger numbers would overflow "
+        text = shown(value)
+        if text.lstrip("-") == shown(MAX_MAGNITUDE):  # just beyond the limit: say by how much
+            text = repr(float(value))
+        raise InstanceError(f"{name} is {text}, beyond ±{MAX_MAGNITUDE:g} (larger numbers would overflow "
                             f"the energy sums)")
     return value
 
