@@ -11,8 +11,9 @@
   MemoryError (an ``error`` row), not a machine-wide swap storm. Workers die with the parent.
 - ``scheduler="tcp://HOST:PORT"`` submits the same :func:`run_one` calls to a Dask distributed
   cluster instead. There a job cannot be hard-killed (Dask runs tasks in threads): a job past its
-  deadline is recorded as ``time_limit`` and its thread is abandoned; a worker that dies is
-  retried by Dask and then recorded as ``error``.
+  deadline is recorded as ``time_limit`` and its thread is abandoned; a job whose worker dies
+  is rerun by Dask on a live worker (one row per job still), and recorded as ``error`` only when
+  its workers die more often than Dask's ``allowed-failures`` (a job that kills every worker).
 - Rows are appended to ``RESULTS_DIR/results.jsonl`` by the parent as each job finishes (see
   :mod:`sarcover.formulations.records` for the format).
 """
