@@ -337,14 +337,21 @@ def _cmd_report(args) -> int:
 COMMANDS = [_add_generate, _add_solve, _add_methods, _add_bench, _add_report]
 
 
-def build_parser() -> argparse.ArgumentParser:
-    from sarcover import __version__
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
 
+    try:
+        return version("sarcover")
+    except PackageNotFoundError:  # a checkout that was never installed
+        return "unknown"
+
+
+def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="sarcover", description="Exact and heuristic benchmarking for multi-view SAR-UAV coverage "
                      "planning", epilog=EXIT_CODES.replace("exit codes:", "exit codes of `sarcover solve`:")
                      + "\nevery other command exits 0 on success and 2 on bad input.",
                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--version", action="version", version=f"sarcover {__version__}")
+    parser.add_argument("--version", action="version", version=f"sarcover {_version()}")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser, required=True)
     for add in COMMANDS:
         add(sub)
