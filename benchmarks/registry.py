@@ -148,7 +148,9 @@ class Method:
 
 
 # Node limits of the methods whose models outgrow the instance's dense matrices: the MILP's and
-# CP-SAT's arc variables and constraints, PyVRP's cover copy of every node, OR-Tools' routing model.
+# CP-SAT's arc variables and constraints, PyVRP's cover copy of every node, OR-Tools' routing model,
+# and the paper's pipelines (their clustering and energy repair grow faster than V²).
+PAPER_MAX_NODES = 2000
 MILP_MAX_NODES = 1000
 CPSAT_MAX_NODES = 800
 PYVRP_MAX_NODES = 2000
@@ -157,15 +159,20 @@ ROUTING_MAX_NODES = 3000
 METHODS: dict[str, Method] = {m.name: m for m in [
     Method("greedy", greedy, False, "cheapest insertion by prize per energy, groups first (floor baseline)"),
     Method("adpc-pso", paper_pipeline("adpc", "pso"), False,
-           "the paper's: ADPC clusters, random-key PSO tours (+2-opt), energy repair and refill", compile_routers),
+           "the paper's: ADPC clusters, random-key PSO tours (+2-opt), energy repair and refill",
+           compile_routers, max_nodes=PAPER_MAX_NODES),
     Method("dpc-pso", paper_pipeline("dpc", "pso"), False,
-           "DPC clusters, random-key PSO tours (+2-opt), energy repair and refill", compile_routers),
+           "DPC clusters, random-key PSO tours (+2-opt), energy repair and refill",
+           compile_routers, max_nodes=PAPER_MAX_NODES),
     Method("kmeans-pso", paper_pipeline("kmeans", "pso"), False,
-           "scikit-learn KMeans clusters, random-key PSO tours (+2-opt), energy repair and refill", compile_routers),
+           "scikit-learn KMeans clusters, random-key PSO tours (+2-opt), energy repair and refill",
+           compile_routers, max_nodes=PAPER_MAX_NODES),
     Method("adpc-ga", paper_pipeline("adpc", "ga"), False,
-           "ADPC clusters, GA tours (OX, inversion, elitism; +2-opt), energy repair and refill", compile_routers),
+           "ADPC clusters, GA tours (OX, inversion, elitism; +2-opt), energy repair and refill",
+           compile_routers, max_nodes=PAPER_MAX_NODES),
     Method("adpc-aco", paper_pipeline("adpc", "aco"), False,
-           "ADPC clusters, elitist ant system tours (+2-opt), energy repair and refill", compile_routers),
+           "ADPC clusters, elitist ant system tours (+2-opt), energy repair and refill",
+           compile_routers, max_nodes=PAPER_MAX_NODES),
     Method("cpsat", cpsat, True,
            "CP-SAT routes constraint + energy flow, greedy hint, 1 thread; optimal only if proven unscaled",
            max_nodes=CPSAT_MAX_NODES),
