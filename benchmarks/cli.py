@@ -48,9 +48,9 @@ def _positive_float(text: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+        raise argparse.ArgumentTypeError(f"not a number: {text[:40]!r}") from None
     if not math.isfinite(value) or value <= 0:
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {text[:40]!r}")
     return value
 
 
@@ -222,7 +222,10 @@ def _cmd_solve(args) -> int:
     else:
         _print(_summary(instance, spec, record))
     if plot is not None:  # on stderr, so that stdout stays one JSON object with --json
-        print(f"plot written to {plot}", file=sys.stderr)
+        try:
+            print(f"plot written to {plot}", file=sys.stderr, flush=True)
+        except OSError:  # nobody reads stderr: the exit code still says how the solve went
+            pass
     return solve_exit_code(run)
 
 
