@@ -115,3 +115,14 @@ def test_both_reports_draw_each_method_alike_with_legends_outside(results, tmp_p
                                                                                            look(m).marker)
     xs = {tuple(lines[m].get_xdata()) for m in METHODS}
     assert len(xs) == len(METHODS)
+
+
+def test_report_header_names_the_results_folder_relative_to_the_report(results, tmp_path):
+    """No machine's absolute path in the report: the source is named from the report's folder."""
+    import os
+
+    out = tmp_path / "report"
+    report.write_report(results, out)
+    text = (out / "report.md").read_text()
+    assert str(results.resolve()) not in text
+    assert f"`results.jsonl` of the results folder `{os.path.relpath(results.resolve(), out.resolve())}`" in text
