@@ -228,3 +228,22 @@ def test_first_eta_leaves_out_the_compilation(tmp_path, monkeypatch):
     harness.run_suite(load_suite(str(suite)), tmp_path / "res", workers=1, stream=stream)
     last = stream.getvalue().strip().splitlines()[-1]
     assert "1/1" in last and "elapsed 0:00" in last, last
+
+
+@pytest.mark.parametrize("method", ["cpsat", "routing", "pyvrp"])
+@pytest.mark.parametrize("tmax, far, optimum", [(1, 1e13, 1.0), (5e-324, 1.0, 2.0)])
+def test_integer_scaled_methods_take_extreme_accepted_numbers(tmp_path, method, tmax, far, optimum):
+    """Numbers within the input limits but far apart (arcs 1e13 times the budget, a budget of the
+    smallest float) used to overflow the integer arc energies of CP-SAT, OR-Tools and PyVRP: an
+    invalid-cast warning, and a TypeError from CP-SAT. Now: no warning, the optimum."""
+    import warnings
+
+    from sarcover.benchmarks.registry import run_method
+    from sarcover.formulations.io import read_top
+
+    path = tmp_path / "t.txt"
+    path.write_text(f"n 5\nm 1\ntmax {tmax!r}\n0 0 0\n{far!r} 0 5\n0 {far!r} 3\n0 0 {optimum!r}\n0 0 0\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        run = run_method(method, read_top(path), time_limit=5)
+    assert str(run.status) in ("optimal", "feasible") and run.objective == optimum, run.reason
