@@ -6,11 +6,13 @@ stderr. Never a traceback, never another exception, never a numpy warning. Examp
 (small lists, few examples, greedy as the only runnable method) so that the default run stays fast.
 """
 
+import atexit
 import contextlib
 import io
 import json
 import math
 import os
+import shutil
 import tempfile
 import warnings
 from pathlib import Path
@@ -28,6 +30,7 @@ from sarcover.formulations.io import load_instance, read_top, sar_from_dict, sar
 FAST = settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 SOLVE_CODES = {EXIT_OK, EXIT_BAD_INPUT, EXIT_NO_PLAN, EXIT_METHOD_ERROR}
 WORK = Path(tempfile.mkdtemp(prefix="sarcover-props-"))  # files the examples read and write
+atexit.register(shutil.rmtree, WORK, ignore_errors=True)
 
 # numbers that break things: huge, tiny, negative, non-finite, integers beyond float
 numbers = st.one_of(
