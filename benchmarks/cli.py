@@ -1,14 +1,37 @@
-"""The `sarcover` command line. Bad input: one line on stderr naming the problem, exit code 2."""
+"""The `sarcover` command line.
+
+Exit codes (README, "Exit codes"): 0 success (for ``solve``: a verified plan came back); 2 bad
+input, with one line on stderr naming the problem; ``solve`` only: 3 no plan (``infeasible``, or
+``no_plan`` / ``time_limit`` without a plan), 4 the method failed (``error``); 130 interrupted.
+A reader that closes stdout early (``| head``) ends the output quietly; the exit code stays the
+command's.
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
 import math
+import os
 import sys
+import textwrap
 from pathlib import Path
 
 from sarcover.formulations.errors import SarcoverError
+from sarcover.formulations.limits import shown
+
+EXIT_OK = 0
+EXIT_BAD_INPUT = 2
+EXIT_NO_PLAN = 3
+EXIT_METHOD_ERROR = 4
+EXIT_INTERRUPTED = 130
+MAX_SEED = 2**31 - 1  # CP-SAT and PyVRP take 32-bit seeds
+
+EXIT_CODES = f"""exit codes:
+  {EXIT_OK}    a verified plan (status optimal, feasible, or time_limit with a plan)
+  {EXIT_BAD_INPUT}    bad input (one line on stderr naming the problem)
+  {EXIT_NO_PLAN}    no plan: infeasible (proven), no_plan or time_limit without a plan
+  {EXIT_METHOD_ERROR}    the method failed (status error: it raised, or the verifier rejected its plan)"""
 
 
 class CLIError(SarcoverError):
@@ -25,23 +48,67 @@ def _positive_float(text: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+        raise argparse.ArgumentTypeError(f"not a number: {text[:40]!r}") from None
     if not math.isfinite(value) or value <= 0:
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {text[:40]!r}")
     return value
 
 
-def _int_at_least(minimum: int):
+def _int_at_least(minimum: int, maximum: int | None = None):
     def parse(text: str) -> int:
         try:
             value = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
-        if value < minimum:
-            raise argparse.ArgumentTypeError(f"must be >= {minimum}, got {value}")
+            raise argparse.ArgumentTypeError(f"not an integer: {text[:40]!r}") from None
+        if value < minimum or (maximum is not None and value > maximum):
+            bounds = f"an integer in [{minimum}, {maximum}]" if maximum is not None else f">= {minimum}"
+            raise argparse.ArgumentTypeError(f"must be {bounds}, got {shown(value)}")
         return value
 
     return parse
+
+
+def _plural(count: int, word: str) -> str:
+    """``1 UAV``, ``2 UAVs``."""
+    return f"{count} {word}" + ("" if count == 1 else "s")
+
+
+_stdout_gone = False
+
+
+def _print(text: str) -> None:
+    """Print a line on stdout. A reader that has gone (``| head``) ends the output, not the
+    command: later output is dropped, and stdout points at /dev/null so that the interpreter's
+    final flush does not complain either."""
+    global _stdout_gone
+    if _stdout_gone:
+        return
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:
+        _stdout_gone = True
+        _silence_stdout()
+
+
+def _silence_stdout() -> None:
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # no file descriptor (captured in a test)
+        pass
+
+
+def _output_file(text: str, flag: str) -> Path:
+    """A file the command may write: its folder exists and it is not a folder itself."""
+    out = Path(text)
+    if "\0" in text:
+        raise CLIError(f"{flag}: {text!r} is not a usable file name")
+    if out.is_dir():
+        raise CLIError(f"{flag}: {out} is a directory; give a file name")
+    if not out.parent.is_dir():
+        raise CLIError(f"{flag}: directory {out.parent} does not exist")
+    return out
 
 
 # -- generate -----------------------------------------------------------------------------------
@@ -52,7 +119,7 @@ def _add_generate(sub):
     p.add_argument("--targets", "-M", type=_int_at_least(1), required=True, help="number of targets M")
     p.add_argument("--views", "-K", type=_int_at_least(1), required=True, help="views per target K")
     p.add_argument("--uavs", "-N", type=_int_at_least(1), required=True, help="number of UAVs N")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=_int_at_least(0, MAX_SEED), default=0, help="random seed (default 0)")
     p.add_argument("--preset", choices=sorted(PRESETS), default="paper", help="parameter preset")
     p.add_argument("--altitude", type=_positive_float, help="override H (m)")
     p.add_argument("--pitch-deg", type=float, help="override θ (degrees)")
@@ -72,12 +139,14 @@ def _cmd_generate(args) -> int:
         altitude=args.altitude, pitch_deg=args.pitch_deg, e_fly=args.e_fly,
         e_image=args.e_image, e_max=args.e_max,
     )
-    out = Path(args.output)
-    if not out.parent.exists():
-        raise CLIError(f"output directory {out.parent} does not exist")
-    save_json(sar, out)
-    print(f"wrote {out}: {sar.n_targets} targets × {sar.n_views} views, {sar.n_uavs} UAVs, E_max {sar.e_max:g}")
-    return 0
+    out = _output_file(args.output, "-o")
+    try:
+        save_json(sar, out)
+    except OSError as exc:
+        raise CLIError(f"-o: cannot write {out} ({exc.strerror or exc})") from None
+    _print(f"wrote {out}: {_plural(sar.n_targets, 'target')} × {_plural(sar.n_views, 'view')}, "
+           f"{_plural(sar.n_uavs, 'UAV')}, E_max {sar.e_max:g}")
+    return EXIT_OK
 
 
 # -- methods ------------------------------------------------------------------------------------
@@ -92,44 +161,87 @@ def _cmd_methods(args) -> int:
     width = max(len(n) for n in METHODS)
     for spec in METHODS.values():
         kind = "exact" if spec.exact else "heuristic"
-        print(f"{spec.name:<{width}}  {kind:<9}  {spec.summary}")
-    return 0
+        _print(f"{spec.name:<{width}}  {kind:<9}  {spec.summary}")
+    return EXIT_OK
 
 
 # -- solve --------------------------------------------------------------------------------------
+DEFAULT_METHOD = "greedy"
+
+
 def _add_solve(sub):
-    p = sub.add_parser("solve", help="solve one instance (sarcover JSON or TOP benchmark file)")
-    p.add_argument("file", help="instance file")
-    p.add_argument("--method", default="greedy", help="registered method (see `sarcover methods`)")
+    p = sub.add_parser(
+        "solve", help="solve one instance (sarcover JSON, TOP benchmark file or shipped benchmark name)",
+        description=textwrap.fill(
+            "Solve one instance with one method and verify the plan. FILE is a sarcover JSON instance "
+            "(`sarcover generate`), a Chao-Golden-Wasil TOP text file, or the name of a shipped TOP benchmark "
+            f"such as p2.3.g. The default method is {DEFAULT_METHOD}.", 78),
+        epilog=EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("file", help="instance: sarcover JSON file, TOP text file, or shipped benchmark name (p2.3.g)")
+    p.add_argument("--method", default=DEFAULT_METHOD,
+                   help=f"registered method (see `sarcover methods`; default {DEFAULT_METHOD})")
     p.add_argument("--time-limit", type=_positive_float, default=60.0, help="seconds (default 60)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=_int_at_least(0, MAX_SEED), default=0, help="random seed (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plot", help="write a PNG of the plan (paper's Fig. 2 style)")
+    p.add_argument("--plot", help="write a picture of the plan (paper's Fig. 2 style; PNG unless the name says "
+                                  "pdf, svg, ...)")
     p.set_defaults(func=_cmd_solve)
 
 
+def solve_exit_code(run) -> int:
+    """The exit code of a solved run: a verified plan, no plan, or a failed method."""
+    from sarcover.formulations.result import SolutionStatus, Termination
+
+    if run.solution is not SolutionStatus.NONE and run.valid:
+        return EXIT_OK
+    if run.termination is Termination.ERROR:
+        return EXIT_METHOD_ERROR
+    return EXIT_NO_PLAN
+
+
 def _cmd_solve(args) -> int:
-    from sarcover.benchmarks.registry import get_method, run_method
+    from sarcover.benchmarks.catalog import instance_path
+    from sarcover.benchmarks.registry import check_size, get_method, run_method
     from sarcover.formulations.io import load_instance
     from sarcover.formulations.records import outcome
 
     spec = get_method(args.method)
-    if args.plot and not Path(args.plot).parent.exists():
-        raise CLIError(f"--plot: directory {Path(args.plot).parent} does not exist")
-    instance = load_instance(args.file)
+    plot = _plot_file(args.plot) if args.plot else None
+    instance = load_instance(instance_path(args.file))
+    check_size(spec, instance.n_nodes, instance.n_vehicles)  # refused before the method allocates it
     if spec.warm_up is not None:  # a pause of ~30 s on a fresh checkout deserves a word
         from sarcover.benchmarks.harness import warm_up_methods
 
         warm_up_methods([spec.name], sys.stderr)
     run = run_method(spec.name, instance, seed=args.seed, time_limit=args.time_limit)
     record = {**outcome(run, instance), "exact": spec.exact}
-    if args.plot:
-        _write_plot(instance, run, record, args.plot)
+    if plot is not None:
+        _write_plot(instance, run, record, plot)
     if args.json:
-        print(json.dumps(record))
+        _print(json.dumps(record))
     else:
-        print(_summary(instance, spec, record))
-    return 0
+        _print(_summary(instance, spec, record))
+    if plot is not None:  # on stderr, so that stdout stays one JSON object with --json
+        try:
+            print(f"plot written to {plot}", file=sys.stderr, flush=True)
+        except OSError:  # nobody reads stderr: the exit code still says how the solve went
+            pass
+    return solve_exit_code(run)
+
+
+def _plot_file(text: str) -> Path:
+    """The --plot file, checked before solving: a writable place and a format matplotlib writes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    out = _output_file(text, "--plot")
+    formats = FigureCanvasBase.get_supported_filetypes()
+    suffix = out.suffix.lower().lstrip(".")
+    if suffix and suffix not in formats:
+        raise CLIError(f"--plot: cannot write a {suffix!r} picture; use one of {', '.join(sorted(formats))}")
+    return out
 
 
 def _write_plot(instance, run, record, path):
@@ -138,19 +250,23 @@ def _write_plot(instance, run, record, path):
     from sarcover.reports.plots import plot_plan
 
     cov = f"{100 * record['coverage']:.1f}%" if record["coverage"] is not None else "no plan"
-    fig, ax = plt.subplots(figsize=(7, 7))
+    fig, ax = plt.subplots(figsize=(8.5, 7))
     plot_plan(instance, run.plan if run.valid else None, ax=ax,
               title=f"{instance.name}: {record['method']} ({record['status']}), coverage {cov}")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        fig.savefig(path, dpi=120)
+    except OSError as exc:
+        raise CLIError(f"--plot: cannot write {path} ({exc.strerror or exc})") from None
+    finally:
+        plt.close(fig)
 
 
 def _summary(instance, spec, rec) -> str:
-    what = "viewpoints" if instance.kind == "sar" else "nodes"
+    what = "viewpoint" if instance.kind == "sar" else "node"
     lines = [
-        f"instance {instance.name}: {instance.n_nodes} {what}, {len(instance.groups)} groups, "
-        f"{instance.n_vehicles} vehicles, budget {instance.budget:g}",
+        f"instance {instance.name}: {_plural(instance.n_nodes, what)}, {_plural(len(instance.groups), 'group')}, "
+        f"{_plural(instance.n_vehicles, 'vehicle')}, budget {instance.budget:g}",
         f"method   {spec.name} ({'exact' if spec.exact else 'heuristic'}): {rec['status']} "
         f"in {rec['runtime_s']:.3f} s" + (f" ({rec['reason']})" if rec["reason"] else ""),
     ]
@@ -161,7 +277,7 @@ def _summary(instance, spec, rec) -> str:
             f"verified {'yes' if rec['valid'] else 'NO'}"
         )
         for r, (route, e) in enumerate(zip(rec["routes"], rec["energy"])):
-            lines.append(f"  vehicle {r + 1}: {len(route)} {what}, energy {e:.6g} / {instance.budget:g}: "
+            lines.append(f"  vehicle {r + 1}: {_plural(len(route), what)}, energy {e:.6g} / {instance.budget:g}: "
                          + " ".join(map(str, route)))
     return "\n".join(lines)
 
@@ -199,9 +315,9 @@ def _cmd_bench(args) -> int:
     summary = run_suite(suite, out, workers=args.workers, resume=args.resume, scheduler=args.scheduler,
                         progress=not args.quiet)
     counts = ", ".join(f"{n} {k}" for k, n in sorted(summary["counts"].items())) or "nothing to run"
-    print(f"{summary['suite']}: ran {summary['ran']} of {summary['jobs']} jobs in {summary['wall_s']:.1f} s "
-          f"({counts}) -> {summary['path']}")
-    return 0
+    _print(f"{summary['suite']}: ran {summary['ran']} of {_plural(summary['jobs'], 'job')} in "
+           f"{summary['wall_s']:.1f} s ({counts}) -> {summary['path']}")
+    return EXIT_OK
 
 
 def _add_report(sub):
@@ -216,16 +332,29 @@ def _cmd_report(args) -> int:
 
     out = Path(args.output) if args.output else Path(args.results) / "report"
     summary = write_report(args.results, out)
-    print(summary)
-    return 0
+    _print(summary)
+    return EXIT_OK
 
 
 # -- main ---------------------------------------------------------------------------------------
 COMMANDS = [_add_generate, _add_solve, _add_methods, _add_bench, _add_report]
 
 
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("sarcover")
+    except PackageNotFoundError:  # a checkout that was never installed
+        return "unknown"
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="sarcover", description="Exact and heuristic benchmarking for multi-view SAR-UAV coverage planning")
+    parser = _Parser(prog="sarcover", description="Exact and heuristic benchmarking for multi-view SAR-UAV coverage "
+                     "planning", epilog=EXIT_CODES.replace("exit codes:", "exit codes of `sarcover solve`:")
+                     + "\nevery other command exits 0 on success and 2 on bad input.",
+                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"sarcover {_version()}")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser, required=True)
     for add in COMMANDS:
         add(sub)
@@ -233,15 +362,27 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    global _stdout_gone
+    _stdout_gone = False
     try:
         args = build_parser().parse_args(argv)
         return args.func(args)
     except SarcoverError as exc:
-        print(f"sarcover: error: {exc}", file=sys.stderr)
-        return 2
+        print(f"sarcover: error: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("sarcover: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # help or version text cut off by `| head`: what was asked for is done
+        _silence_stdout()
+        return EXIT_OK
+    except SystemExit as exc:  # --help and --version end argparse with SystemExit(0)
+        return exc.code if isinstance(exc.code, int) else EXIT_OK
+
+
+def _one_line(exc: Exception) -> str:
+    """The error's message on one line (a file name or an argument may hold a line break)."""
+    return " ".join(str(exc).splitlines())
 
 
 if __name__ == "__main__":

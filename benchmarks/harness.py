@@ -11,8 +11,9 @@
   MemoryError (an ``error`` row), not a machine-wide swap storm. Workers die with the parent.
 - ``scheduler="tcp://HOST:PORT"`` submits the same :func:`run_one` calls to a Dask distributed
   cluster instead. There a job cannot be hard-killed (Dask runs tasks in threads): a job past its
-  deadline is recorded as ``time_limit`` and its thread is abandoned; a worker that dies is
-  retried by Dask and then recorded as ``error``.
+  deadline is recorded as ``time_limit`` and its thread is abandoned; a job whose worker dies
+  is rerun by Dask on a live worker (one row per job still), and recorded as ``error`` only when
+  its workers die more often than Dask's ``allowed-failures`` (a job that kills every worker).
 - Rows are appended to ``RESULTS_DIR/results.jsonl`` by the parent as each job finishes (see
   :mod:`sarcover.formulations.records` for the format).
 """
@@ -175,11 +176,39 @@ def _clean(obj):
 
 
 # -- results store --------------------------------------------------------------------------------
+def stored_suites(directory: Path) -> set[str]:
+    """Names of the suites whose rows ``directory`` holds (the ``suite`` of its rows; a row
+    without one counts by the folder's suite.toml, the copy its first run wrote)."""
+    names: set[str] = set()
+    unnamed = False
+    with (directory / RESULTS_FILE).open("rb") as fh:
+        for raw in fh:
+            try:
+                name = json.loads(raw).get("suite")
+            except (ValueError, AttributeError):
+                continue  # a torn line; read_rows counts it
+            if isinstance(name, str):
+                names.add(name)
+            else:
+                unnamed = True
+    if unnamed or not names:
+        copy = directory / "suite.toml"
+        try:
+            import tomllib
+
+            name = tomllib.loads(copy.read_text()).get("name", None)
+        except (OSError, ValueError):
+            name = None
+        if isinstance(name, str):
+            names.add(name)
+    return names
+
+
 class ResultsStore:
     """Append-only JSON Lines log. Each row is flushed to the OS as written (SIGKILL-safe) and
     fsynced at most once a second (bounds the loss on a power cut)."""
 
-    def __init__(self, directory: str | Path, *, resume: bool):
+    def __init__(self, directory: str | Path, *, resume: bool, suite: str | None = None):
         self.directory = Path(directory)
         self.path = self.directory / RESULTS_FILE
         self.keys: set[str] = set()
@@ -188,6 +217,11 @@ class ResultsStore:
             raise HarnessError(f"{self.directory} exists and is not a directory")
         self.directory.mkdir(parents=True, exist_ok=True)
         if self.path.exists() and self.path.stat().st_size > 0:
+            held = stored_suites(self.directory)
+            other = sorted(held - {suite}) if suite is not None else []
+            if other:  # one folder, one suite: its report is that suite's, and its job keys are
+                raise HarnessError(f"{self.directory} holds results of suite {', '.join(map(repr, other))}, "
+                                   f"not {suite!r}; choose another -o")
             if not resume:
                 raise HarnessError(f"{self.directory} already holds results; pass --resume to continue "
                                    f"that run, or choose another -o")
@@ -492,9 +526,18 @@ def connect(address: str):
         raise HarnessError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
 
 
+def warm_up_dask(client, methods) -> None:
+    """Compile the numba code of ``methods`` on every worker of the cluster ``client`` reaches
+    (see :func:`warm_up_methods`); a worker that joins later compiles in its first job."""
+    try:
+        client.run(warm_up, list(methods))
+    except Exception:  # noqa: BLE001 - a worker that cannot warm up compiles in its job
+        pass
+
+
 def run_dask(jobs: list[dict], emit, *, scheduler, warm=()) -> None:
     """Run ``jobs`` on a Dask cluster (an address like ``tcp://host:8786`` or a Client). The
-    methods in ``warm`` compile their numba code on every worker first (see :func:`warm_up_methods`)."""
+    methods in ``warm`` compile their numba code on every worker first (:func:`warm_up_dask`)."""
     if not jobs:
         return
     from dask.distributed import Client, as_completed
@@ -503,10 +546,7 @@ def run_dask(jobs: list[dict], emit, *, scheduler, warm=()) -> None:
     client = connect(scheduler) if own else scheduler
     try:
         if warm:
-            try:
-                client.run(warm_up, list(warm))
-            except Exception:  # noqa: BLE001 - a worker that cannot warm up compiles in its job
-                pass
+            warm_up_dask(client, warm)
         futures = {}
         for job in jobs:
             futures[client.submit(run_one_guarded, job, pure=False)] = job
@@ -544,7 +584,7 @@ def run_suite(suite: Suite, out_dir: str | Path, *, workers: int | None = None, 
 
 
 def _run_suite(suite, out_dir, workers, resume, scheduler, address, progress, stream) -> dict:
-    store = ResultsStore(out_dir, resume=resume)
+    store = ResultsStore(out_dir, resume=resume, suite=suite.name)
     stream = stream or sys.stderr
     try:
         suite_copy = store.directory / "suite.toml"
@@ -559,19 +599,23 @@ def _run_suite(suite, out_dir, workers, resume, scheduler, address, progress, st
             stream.write(f"suite {suite.name}: {len(suite.jobs)} jobs ({suite.n_instances} instances × "
                          f"{len(suite.methods)} methods), {stored} already stored, {len(todo)} to run on {where}\n")
         payload = [{**j.as_dict(), "suite": suite.name, "workers": None if scheduler else workers} for j in todo]
+        t0 = time.monotonic()
+        started = _now()
+        methods = sorted({job["method"] for job in payload})
+        if payload:  # the numba compilation comes first, so the progress bar's ETA leaves it out
+            if scheduler:
+                warm_up_dask(scheduler, methods)
+            else:
+                warm_up_methods(methods, stream if progress else None)
         bar = Progress(len(todo), f"bench {suite.name}", stream=stream, enabled=progress)
 
         def emit(row: dict) -> None:
             store.append(row)
             bar.update(row["status"])
 
-        t0 = time.monotonic()
-        started = _now()
-        methods = sorted({job["method"] for job in payload})
         if scheduler:
-            run_dask(payload, emit, scheduler=scheduler, warm=methods)
+            run_dask(payload, emit, scheduler=scheduler)
         else:
-            warm_up_methods(methods, stream if progress else None)
             run_local(payload, emit, workers=workers, memory_mb=suite.memory_mb)
         wall = time.monotonic() - t0
         with (store.directory / "runs.jsonl").open("a") as fh:

@@ -29,6 +29,7 @@ from typing import Callable
 from sarcover.formulations.errors import SarcoverError
 from sarcover.formulations.history import shifted
 from sarcover.formulations.instance import TOPInstance, precheck
+from sarcover.formulations.limits import MAX_NODES, MAX_VEHICLES, too_large
 from sarcover.formulations.result import Result, Termination, VerifiedResult, verified_result
 
 
@@ -134,28 +135,50 @@ class Method:
     # compiles the method's numba code (or loads it from numba's disk cache), so that a
     # benchmark does not charge the compilation to the method's first job
     warm_up: Callable[[], None] | None = None
+    # the largest instance the method holds within a benchmark worker's default memory
+    # (formulations/limits.py; docs/limits.md says how each limit was chosen)
+    max_nodes: int = MAX_NODES
+    max_vehicles: int = MAX_VEHICLES
 
+
+# Node limits of the methods whose models outgrow the instance's dense matrices: the MILP's and
+# CP-SAT's arc variables and constraints, PyVRP's cover copy of every node, OR-Tools' routing model,
+# and the paper's pipelines (their clustering and energy repair grow faster than V²).
+PAPER_MAX_NODES = 2000
+MILP_MAX_NODES = 1000
+CPSAT_MAX_NODES = 800
+PYVRP_MAX_NODES = 2000
+ROUTING_MAX_NODES = 3000
 
 METHODS: dict[str, Method] = {m.name: m for m in [
     Method("greedy", greedy, False, "cheapest insertion by prize per energy, groups first (floor baseline)"),
     Method("adpc-pso", paper_pipeline("adpc", "pso"), False,
-           "the paper's: ADPC clusters, random-key PSO tours (+2-opt), energy repair and refill", compile_routers),
+           "the paper's: ADPC clusters, random-key PSO tours (+2-opt), energy repair and refill",
+           compile_routers, max_nodes=PAPER_MAX_NODES),
     Method("dpc-pso", paper_pipeline("dpc", "pso"), False,
-           "DPC clusters, random-key PSO tours (+2-opt), energy repair and refill", compile_routers),
+           "DPC clusters, random-key PSO tours (+2-opt), energy repair and refill",
+           compile_routers, max_nodes=PAPER_MAX_NODES),
     Method("kmeans-pso", paper_pipeline("kmeans", "pso"), False,
-           "scikit-learn KMeans clusters, random-key PSO tours (+2-opt), energy repair and refill", compile_routers),
+           "scikit-learn KMeans clusters, random-key PSO tours (+2-opt), energy repair and refill",
+           compile_routers, max_nodes=PAPER_MAX_NODES),
     Method("adpc-ga", paper_pipeline("adpc", "ga"), False,
-           "ADPC clusters, GA tours (OX, inversion, elitism; +2-opt), energy repair and refill", compile_routers),
+           "ADPC clusters, GA tours (OX, inversion, elitism; +2-opt), energy repair and refill",
+           compile_routers, max_nodes=PAPER_MAX_NODES),
     Method("adpc-aco", paper_pipeline("adpc", "aco"), False,
-           "ADPC clusters, elitist ant system tours (+2-opt), energy repair and refill", compile_routers),
+           "ADPC clusters, elitist ant system tours (+2-opt), energy repair and refill",
+           compile_routers, max_nodes=PAPER_MAX_NODES),
     Method("cpsat", cpsat, True,
-           "CP-SAT routes constraint + energy flow, greedy hint, 1 thread; optimal only if proven unscaled"),
+           "CP-SAT routes constraint + energy flow, greedy hint, 1 thread; optimal only if proven unscaled",
+           max_nodes=CPSAT_MAX_NODES),
     Method("routing", routing, False,
-           "OR-Tools routing, prize disjunctions + energy dimension, guided local search, <=10 s"),
+           "OR-Tools routing, prize disjunctions + energy dimension, guided local search, <=10 s",
+           max_nodes=ROUTING_MAX_NODES),
     Method("pyvrp", pyvrp, False,
-           "PyVRP iterated local search, optional clients with prizes, max distance = energy, 2000 its"),
+           "PyVRP iterated local search, optional clients with prizes, max distance = energy, 2000 its",
+           max_nodes=PYVRP_MAX_NODES),
     Method("milp", milp, True,
-           "time-flow TOP MILP on HiGHS via Pyomo: pruned arcs, cliques, path + connectivity cuts, 1 thread, gap 0"),
+           "time-flow TOP MILP on HiGHS via Pyomo: pruned arcs, cliques, path + connectivity cuts, 1 thread, gap 0",
+           max_nodes=MILP_MAX_NODES),
     Method("bp", bp, True,
            "branch-and-price: route master on HiGHS, ng-route labelling pricing (numba), greedy's routes "
            "as first columns, PyVRP as primal heuristic once the root leaves the proof open, 1 thread",
@@ -185,6 +208,16 @@ def get_method(name: str) -> Method:
     except (ImportError, AttributeError, ValueError) as exc:
         raise SarcoverError(f"method {name!r}: cannot import {func!r} from {module!r} ({exc})") from None
     return Method(name, run, False, "ad hoc (named by a suite)")
+
+
+def check_size(method: Method | str, n_nodes: int, n_vehicles: int) -> None:
+    """Raise :class:`~sarcover.formulations.limits.TooLargeError` for an instance of more nodes
+    or vehicles than ``method`` holds in memory (its ``max_nodes``, ``max_vehicles``)."""
+    spec = method if isinstance(method, Method) else get_method(method)
+    if n_nodes > spec.max_nodes:
+        raise too_large(f"{n_nodes} nodes", spec.max_nodes, "nodes", holder=spec.name)
+    if n_vehicles > spec.max_vehicles:
+        raise too_large(f"{n_vehicles} vehicles", spec.max_vehicles, "vehicles", holder=spec.name)
 
 
 def warm_up(names) -> list[str]:
@@ -218,11 +251,17 @@ def run_method(name: str, instance: TOPInstance, *, seed: int = 0, time_limit: f
     always the verifier's, never the method's own claim.
     """
     t0 = time.perf_counter()
+    try:
+        spec = get_method(name)
+        check_size(spec, instance.n_nodes, instance.n_vehicles)  # before the method allocates it
+    except Exception as exc:  # noqa: BLE001 - unknown method, or beyond the method's memory limits
+        return VerifiedResult.failed(name, Termination.ERROR, f"{type(exc).__name__}: {exc}",
+                                     time.perf_counter() - t0)
     reason = precheck(instance)
     if reason is not None:
         return VerifiedResult.failed(name, Termination.INFEASIBLE, reason, time.perf_counter() - t0)
     try:
-        result = get_method(name).run(instance, seed=seed, time_limit=time_limit)
+        result = spec.run(instance, seed=seed, time_limit=time_limit)
     except Exception as exc:  # a method bug must not stop a benchmark
         tb = traceback.format_exc(limit=-3).strip().splitlines()
         return VerifiedResult.failed(name, Termination.ERROR, f"{type(exc).__name__}: {exc}",

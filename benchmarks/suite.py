@@ -189,7 +189,7 @@ def _build(data: dict, path: Path, text: str, runs_override: int | None) -> Suit
             _no_unknown(spec, _FILE_KEYS, swhere)
             instances = _file_sources(spec["files"], path.parent, swhere)
         else:
-            instances = _generated_sources(spec, swhere, runs_override)
+            instances = _generated_sources(spec, swhere, runs_override, set_methods)
         for inst_id, source, run in instances:
             if sources.setdefault(inst_id, source) != source:
                 raise SuiteError(f"{swhere}: instance name {inst_id!r} is used for two different instances")
@@ -248,9 +248,11 @@ def check_method(name: str, where: str) -> bool:
     raise SuiteError(f"{where}: unknown method {name!r}; registered: {', '.join(METHODS)}")
 
 
-def _generated_sources(spec: dict, where: str, runs_override: int | None):
+def _generated_sources(spec: dict, where: str, runs_override: int | None, methods: list[str]):
+    from sarcover.benchmarks.registry import check_size
     from sarcover.formulations.errors import InstanceError
     from sarcover.formulations.generate import PRESETS, generate
+    from sarcover.formulations.limits import check_sar_size
 
     unknown = set(spec) - _GEN_KEYS - set(_GEN_OVERRIDES)
     if unknown:
@@ -269,7 +271,11 @@ def _generated_sources(spec: dict, where: str, runs_override: int | None):
     suffix = "" if preset == "paper" else f"-{preset}"
     if overrides:
         suffix += "-" + "-".join(f"{k}{v:g}" for k, v in sorted(overrides.items()))
-    try:  # one trial draw validates the parameters the generator checks
+    try:  # sizes first (no job may be beyond what its method holds), then one trial draw
+        for m, k, n in itertools.product(grid["M"], grid["K"], grid["N"]):
+            check_sar_size(m, k, n)
+            for method in methods:
+                check_size(method, m * k, n)
         generate(grid["M"][0], grid["K"][0], grid["N"][0], seed0, preset, **overrides)
     except InstanceError as exc:
         raise SuiteError(f"{where}: {exc}") from None

@@ -74,6 +74,7 @@ from sarcover.formulations.history import History
 from sarcover.formulations.instance import TOPInstance, precheck
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
+from sarcover.formulations.scaling import integer_arcs
 from sarcover.formulations.verify import REL_TOL, verify
 
 TARGET_SCALED_BUDGET = 1e7
@@ -97,8 +98,10 @@ def prize_scale(prizes: np.ndarray) -> int:
 
 
 def cost_scale(budget: float) -> float:
-    """S such that the scaled budget is about 10^7 (1 if the budget is 0)."""
-    return TARGET_SCALED_BUDGET / budget if budget > 0 else 1.0
+    """S such that the scaled budget is about 10^7 (1 if the budget is 0). A budget below the
+    verifier's absolute tolerance (1e-12) counts as that tolerance: the relaxed budget includes
+    it, and S / budget would not even be a float for the smallest budgets."""
+    return TARGET_SCALED_BUDGET / max(budget, 1e-12) if budget > 0 else 1.0
 
 
 class _Data:
@@ -109,18 +112,20 @@ class _Data:
         v = instance.n_nodes
         cost = instance.cost_matrix()
         self.scale = cost_scale(instance.budget)
-        ceil = np.ceil(cost * self.scale)
+        rb = math.floor(self.scale * (instance.budget * (1.0 + REL_TOL) + 1e-12))
+        # an arc above the relaxed budget fits no route and is pruned below: cut at rb + 1, it
+        # cannot overflow int64 however far it reaches (arcs below keep ceil(scale·cost) exactly)
+        ceil = integer_arcs(cost, self.scale, rb + 1).astype(float)
         if relaxed:
             icost = np.maximum(ceil - 1.0, 0.0)
-            ibudget = math.floor(self.scale * (instance.budget * (1.0 + REL_TOL) + 1e-12))
+            ibudget = rb
         else:
             icost = ceil
             ibudget = math.floor(self.scale * instance.budget)
         self.budget = int(ibudget)
         # Pruning always uses the relaxed costs so both models see the same graph (pruning by
         # relaxed costs removes only arcs no truly feasible route uses).
-        rc = np.maximum(np.ceil(cost * self.scale) - 1.0, 0.0).astype(np.int64)
-        rb = math.floor(self.scale * (instance.budget * (1.0 + REL_TOL) + 1e-12))
+        rc = np.maximum(ceil - 1.0, 0.0).astype(np.int64)
         nodes = np.arange(1, v + 1)
         trip = rc[0, nodes] + rc[nodes, v + 1]
         self.nodes = [int(i) - 1 for i in nodes[trip <= rb]]  # node ids

@@ -6,6 +6,7 @@ import numpy as np
 
 from sarcover.formulations.errors import InstanceError
 from sarcover.formulations.instance import SARInstance
+from sarcover.formulations.limits import check_sar_size
 
 AREA = 2000.0  # metres; targets uniform in [0, AREA]^2, base at the corner (0, 0)
 
@@ -34,8 +35,12 @@ def generate(
     """Draw M targets uniformly in the 2000 m square (seeded) and apply a parameter preset."""
     if preset not in PRESETS:
         raise InstanceError(f"unknown preset {preset!r}; known: {', '.join(PRESETS)}")
-    if isinstance(n_targets, bool) or not isinstance(n_targets, int) or n_targets < 1:
+    if isinstance(n_targets, bool) or not isinstance(n_targets, (int, np.integer)) or n_targets < 1:
         raise InstanceError(f"targets must be an integer >= 1, got {n_targets!r}")
+    for name, value, least in (("views", n_views, 1), ("uavs", n_uavs, 1), ("seed", seed, 0)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
+            raise InstanceError(f"{name} must be an integer >= {least}, got {value!r}")
+    check_sar_size(n_targets, n_views, n_uavs)  # before drawing M targets
     params = dict(PRESETS[preset])
     for key, value in overrides.items():
         if key not in params:

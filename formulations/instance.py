@@ -13,19 +13,24 @@ import numpy as np
 
 from sarcover.formulations.errors import InstanceError
 from sarcover.formulations.geometry import viewpoints
+from sarcover.formulations.limits import (MAX_MAGNITUDE, MAX_NODES, MAX_VEHICLES, check_magnitude, check_sar_size,
+                                          shown, too_large)
 
 
 def _finite(name: str, value: float, *, positive: bool = False, nonnegative: bool = False) -> float:
+    if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
+        check_magnitude(name, value)  # before float(): a huge integer does not convert
     try:
         value = float(value)
     except (TypeError, ValueError):
-        raise InstanceError(f"{name} must be a number, got {value!r}") from None
+        raise InstanceError(f"{name} must be a number, got {shown(value)}") from None
     if not math.isfinite(value):
-        raise InstanceError(f"{name} must be finite, got {value!r}")
+        raise InstanceError(f"{name} must be finite, got {shown(value)}")
+    check_magnitude(name, value)
     if positive and value <= 0:
-        raise InstanceError(f"{name} must be > 0, got {value!r}")
+        raise InstanceError(f"{name} must be > 0, got {shown(value)}")
     if nonnegative and value < 0:
-        raise InstanceError(f"{name} must be >= 0, got {value!r}")
+        raise InstanceError(f"{name} must be >= 0, got {shown(value)}")
     return value
 
 
@@ -34,15 +39,17 @@ def _count(name: str, value: int, minimum: int = 1) -> int:
         if isinstance(value, float) and value.is_integer():
             value = int(value)
         else:
-            raise InstanceError(f"{name} must be an integer, got {value!r}")
+            raise InstanceError(f"{name} must be an integer, got {shown(value)}")
     if value < minimum:
-        raise InstanceError(f"{name} must be >= {minimum}, got {value}")
+        raise InstanceError(f"{name} must be >= {minimum}, got {shown(value)}")
     return int(value)
 
 
 def _points(name: str, value, *, allow_empty: bool = False) -> np.ndarray:
     try:
         arr = np.asarray(value, dtype=float)
+    except OverflowError:  # an integer too large for a float
+        raise InstanceError(f"{name} has a coordinate beyond ±{MAX_MAGNITUDE:g}") from None
     except (TypeError, ValueError):
         raise InstanceError(f"{name} must be a list of [x, y] number pairs") from None
     if arr.size == 0 and allow_empty:
@@ -52,6 +59,9 @@ def _points(name: str, value, *, allow_empty: bool = False) -> np.ndarray:
     if not np.all(np.isfinite(arr)):
         row = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
         raise InstanceError(f"{name}[{row}] has a coordinate that is not a finite number")
+    if arr.size and np.abs(arr).max() > MAX_MAGNITUDE:
+        row = int(np.flatnonzero((np.abs(arr) > MAX_MAGNITUDE).any(axis=1))[0])
+        check_magnitude(f"{name}[{row}]", float(np.abs(arr[row]).max()))
     arr = arr.copy()
     arr.setflags(write=False)
     return arr
@@ -80,6 +90,7 @@ class SARInstance:
         object.__setattr__(self, "targets", _points("targets", self.targets))
         object.__setattr__(self, "n_views", _count("views", self.n_views))
         object.__setattr__(self, "n_uavs", _count("uavs", self.n_uavs))
+        check_sar_size(self.targets.shape[0], self.n_views, self.n_uavs)  # before the viewpoints are computed
         object.__setattr__(self, "altitude", _finite("altitude", self.altitude, positive=True))
         pitch = _finite("pitch_deg", self.pitch_deg)
         if not 0.0 <= pitch < 90.0:
@@ -88,7 +99,14 @@ class SARInstance:
         object.__setattr__(self, "e_fly", _finite("e_fly", self.e_fly, positive=True))
         object.__setattr__(self, "e_image", _finite("e_image", self.e_image, positive=True))
         object.__setattr__(self, "e_max", _finite("e_max", self.e_max, positive=True))
-        viewpoints(self.targets, self.n_views, self.altitude, self.pitch_deg)  # raises on a target at base
+        views = viewpoints(self.targets, self.n_views, self.altitude, self.pitch_deg)  # raises on a target at base
+        if not np.all(np.isfinite(views)):  # a target so close to the base that H·cosθ/‖t‖ overflows
+            m = int(np.flatnonzero(~np.isfinite(views).all(axis=1))[0]) // self.n_views
+            raise InstanceError(f"target {m} lies too close to the base (0, 0) for its viewpoints to be computed")
+        if np.abs(views).max() > MAX_MAGNITUDE:  # a target near the limit, its views H·cosθ beyond it
+            m = int(np.flatnonzero((np.abs(views) > MAX_MAGNITUDE).any(axis=1))[0]) // self.n_views
+            raise InstanceError(f"target {m} has viewpoints beyond ±{MAX_MAGNITUDE:g} (larger numbers would "
+                                f"overflow the energy sums)")
 
     @property
     def n_targets(self) -> int:
@@ -125,12 +143,16 @@ class TOPInstance:
 
     def __post_init__(self):
         coords = _points("coords", self.coords, allow_empty=True)
+        if coords.shape[0] > MAX_NODES:  # before any (V+2)² matrix exists
+            raise too_large(f"{coords.shape[0]} nodes", MAX_NODES, "nodes")
         object.__setattr__(self, "coords", coords)
         prizes = np.asarray(self.prizes, dtype=float).reshape(-1)
         if prizes.shape[0] != coords.shape[0]:
             raise InstanceError(f"prizes has {prizes.shape[0]} entries for {coords.shape[0]} nodes")
         if not np.all(np.isfinite(prizes)) or np.any(prizes < 0):
             raise InstanceError("prizes must be finite and >= 0")
+        if prizes.size and prizes.max() > MAX_MAGNITUDE:
+            check_magnitude(f"prizes[{int(np.argmax(prizes))}]", float(prizes.max()))
         prizes = prizes.copy()
         prizes.setflags(write=False)
         object.__setattr__(self, "prizes", prizes)
@@ -139,6 +161,8 @@ class TOPInstance:
             object.__setattr__(self, name, pt)
         object.__setattr__(self, "budget", _finite("budget", self.budget, nonnegative=True))
         object.__setattr__(self, "n_vehicles", _count("n_vehicles", self.n_vehicles))
+        if self.n_vehicles > MAX_VEHICLES:
+            raise too_large(f"n_vehicles = {shown(self.n_vehicles)}", MAX_VEHICLES, "vehicles")
         object.__setattr__(self, "e_fly", _finite("e_fly", self.e_fly, positive=True))
         object.__setattr__(self, "e_image", _finite("e_image", self.e_image, nonnegative=True))
         groups = tuple(tuple(int(i) for i in g) for g in self.groups)

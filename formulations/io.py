@@ -10,10 +10,12 @@ import numpy as np
 
 from sarcover.formulations.errors import InstanceError
 from sarcover.formulations.instance import SARInstance, TOPInstance, to_top
+from sarcover.formulations.limits import MAX_MAGNITUDE, MAX_NODES, MAX_VEHICLES, TooLargeError, shown, too_large
 
 FORMAT = "sarcover-instance"
 FORMAT_VERSION = 1
 SAR_FIELDS = ("targets", "views", "uavs", "altitude", "pitch_deg", "e_fly", "e_image", "e_max")
+ALL_FIELDS = ("format", "version", "name") + SAR_FIELDS  # a file with any other field is refused
 
 
 def sar_to_dict(sar: SARInstance) -> dict:
@@ -44,13 +46,19 @@ def sar_from_dict(data, source: str = "instance") -> SARInstance:
         raise InstanceError(f"{source}: field 'format' must be {FORMAT!r}")
     if "version" not in data:
         raise InstanceError(f"{source}: missing field 'version'")
-    if data["version"] != FORMAT_VERSION:
+    if isinstance(data["version"], bool) or data["version"] != FORMAT_VERSION:
         raise InstanceError(
-            f"{source}: field 'version' is {data['version']!r}; this sarcover reads version {FORMAT_VERSION}"
+            f"{source}: field 'version' is {shown(data['version'])}; this sarcover reads version {FORMAT_VERSION}"
         )
     for name in SAR_FIELDS:
         if name not in data:
             raise InstanceError(f"{source}: missing field '{name}'")
+    unknown = sorted(str(k) for k in data if k not in ALL_FIELDS)
+    if unknown:  # a misspelt field would otherwise be ignored silently
+        raise InstanceError(f"{source}: unknown field {unknown[0][:40]!r}; a sarcover instance has "
+                            f"{', '.join(ALL_FIELDS)}")
+    if not isinstance(data.get("name", ""), str):
+        raise InstanceError(f"{source}: field 'name' must be a string")
     targets = data["targets"]
     if not isinstance(targets, list) or not targets:
         raise InstanceError(f"{source}: field 'targets' must be a non-empty list of [x, y] pairs")
@@ -60,9 +68,12 @@ def sar_from_dict(data, source: str = "instance") -> SARInstance:
             or len(t) != 2
             or not all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in t)
         ):
-            raise InstanceError(f"{source}: field 'targets[{i}]' must be a pair of numbers, got {t!r}")
-        if not all(math.isfinite(c) for c in t):
+            raise InstanceError(f"{source}: field 'targets[{i}]' must be a pair of numbers, got {shown(t)}")
+        if not all(isinstance(c, int) or math.isfinite(c) for c in t):
             raise InstanceError(f"{source}: field 'targets[{i}]' has a coordinate that is not finite")
+        if not all(abs(c) <= MAX_MAGNITUDE for c in t):
+            raise InstanceError(f"{source}: field 'targets[{i}]' has a coordinate beyond ±{MAX_MAGNITUDE:g} "
+                                f"(larger numbers would overflow the energy sums)")
     for name in ("altitude", "pitch_deg", "e_fly", "e_image", "e_max"):
         v = data[name]
         if isinstance(v, bool) or not isinstance(v, (int, float)):
@@ -77,8 +88,10 @@ def sar_from_dict(data, source: str = "instance") -> SARInstance:
             e_fly=data["e_fly"],
             e_image=data["e_image"],
             e_max=data["e_max"],
-            name=str(data.get("name", source)),
+            name=data.get("name", source),
         )
+    except TooLargeError as exc:
+        raise TooLargeError(f"{source}: {exc}") from None
     except InstanceError as exc:
         raise InstanceError(f"{source}: field {exc}") from None
 
@@ -90,6 +103,10 @@ def load_sar(path: str | Path) -> SARInstance:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise InstanceError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    except ValueError as exc:  # e.g. an integer of more digits than Python converts
+        raise InstanceError(f"{path}: not valid JSON ({str(exc).splitlines()[0][:80]})") from None
+    except RecursionError:
+        raise InstanceError(f"{path}: not valid JSON (nested too deeply)") from None
     return sar_from_dict(data, source=str(path))
 
 
@@ -107,7 +124,14 @@ def read_top(path: str | Path) -> TOPInstance:
             raise InstanceError(f"{path}: '{key}' is not a number: {row[1]!r}") from None
     if len(header) < 3:
         raise InstanceError(f"{path}: missing the n, m, tmax header")
+    for key in ("n", "m"):
+        if not header[key].is_integer() or header[key] < 1:  # also refuses nan and inf
+            raise InstanceError(f"{path}: '{key}' must be a positive integer, got {shown(header[key])}")
     n, m = int(header["n"]), int(header["m"])
+    if n > MAX_NODES + 2:  # checked before any point array is built
+        raise too_large(f"{path}: n = {shown(n)} points", MAX_NODES + 2, "points")
+    if m > MAX_VEHICLES:
+        raise too_large(f"{path}: m = {shown(m)} vehicles", MAX_VEHICLES, "vehicles")
     rows = lines[3:]
     if n < 2 or len(rows) != n:
         raise InstanceError(f"{path}: header says n {n} points, file has {len(rows)} point rows")
@@ -131,7 +155,7 @@ def read_top(path: str | Path) -> TOPInstance:
             kind="top",
         )
     except InstanceError as exc:
-        raise InstanceError(f"{path}: {exc}") from None
+        raise type(exc)(f"{path}: {exc}") from None
 
 
 def load_instance(path: str | Path) -> TOPInstance:
@@ -156,3 +180,5 @@ def _read_text(path: Path) -> str:
         raise InstanceError(f"{path}: not a text file") from None
     except OSError as exc:
         raise InstanceError(f"{path}: cannot read ({exc.strerror})") from None
+    except ValueError:  # a name the operating system cannot take (a NUL byte)
+        raise InstanceError(f"{str(path)!r}: not a usable file name") from None

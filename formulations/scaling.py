@@ -20,6 +20,24 @@ import numpy as np
 from sarcover.formulations.instance import TOPInstance
 
 DEFAULT_RESOLUTION = 10**6  # integer units per budget: arc rounding loses <= 1e-6 of E_max per arc
+MAX_EXPONENT = 300  # scales stay within 1e±300, so that a tiny budget cannot make one infinite
+
+
+def power_of_ten_scale(target: float, reference: float) -> float:
+    """The smallest power of ten s with s·reference >= target (1 when reference is 0), within
+    1e±MAX_EXPONENT (computed on logarithms: target / reference may not be a float)."""
+    if reference <= 0:
+        return 1.0
+    exponent = math.ceil(math.log10(target) - math.log10(reference))
+    return 10.0 ** max(-MAX_EXPONENT, min(MAX_EXPONENT, exponent))
+
+
+def integer_arcs(cost: np.ndarray, scale: float, cap: int) -> np.ndarray:
+    """``ceil(scale * cost)`` as int64, arcs above ``cap`` cut to it. Give a cap above the integer
+    budget: such an arc fits no route whatever its cost, and the cut keeps an arc far dearer than
+    the budget from overflowing int64 (the multiplication comes after the cut, so it cannot
+    overflow either). Arcs below the cap are exactly ``ceil(scale * cost)``."""
+    return np.ceil(np.minimum(cost, cap / scale) * scale).astype(np.int64)
 
 
 @dataclass(frozen=True)
@@ -50,11 +68,11 @@ def scaled_costs(instance: TOPInstance, resolution: int = DEFAULT_RESOLUTION) ->
     """
     cost = instance.cost_matrix()
     reference = instance.budget if instance.budget > 0 else float(cost.max(initial=0.0))
-    scale = 10.0 ** math.ceil(math.log10(resolution / reference)) if reference > 0 else 1.0
-    arc = np.ceil(cost * scale).astype(np.int64)
+    scale = power_of_ten_scale(resolution, reference)
+    budget = int(math.floor(instance.budget * scale))
+    arc = integer_arcs(cost, scale, budget + 1)
     np.fill_diagonal(arc, 0)
     arc[0, -1] = 0  # an empty route stays home and costs nothing
-    budget = int(math.floor(instance.budget * scale))
     return ScaledCosts(scale=scale, arc=arc, budget=budget)
 
 

@@ -44,7 +44,7 @@ from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
-from sarcover.formulations.scaling import integer_prizes, scaled_costs
+from sarcover.formulations.scaling import integer_arcs, integer_prizes, scaled_costs
 from sarcover.formulations.verify import verify
 from sarcover.heuristics.greedy import greedy
 
@@ -111,8 +111,8 @@ def solve_routing(
     sel = np.concatenate([[0], model_nodes + 1, [instance.n_nodes + 1]])  # model order -> solver order
     energy = sc.arc[np.ix_(sel, sel)]
     # tie-break travel cost: TIEBREAK_UNITS per E_max, rounded up, start→end arc 0 like energy
-    travel = np.ceil(instance.cost_matrix()[np.ix_(sel, sel)] * (TIEBREAK_UNITS / max(instance.budget, 1e-300)))
-    travel = np.minimum(travel, 10 * TIEBREAK_UNITS).astype(np.int64)  # arcs beyond the budget never fit
+    travel = integer_arcs(instance.cost_matrix()[np.ix_(sel, sel)], TIEBREAK_UNITS / max(instance.budget, 1e-300),
+                          10 * TIEBREAK_UNITS)  # cut: arcs beyond the budget never fit
     np.fill_diagonal(travel, 0)
     travel[0, -1] = 0
     max_travel = n_veh * (TIEBREAK_UNITS + len(model_nodes) + 2)  # above any feasible plan's travel cost

@@ -1,4 +1,5 @@
-"""Plot functions. Each takes ``ax=None``, draws, and neither shows nor saves."""
+"""Plot functions. Each takes ``ax=None``, draws, and neither shows nor saves. Methods keep the
+look :mod:`sarcover.reports.style` gives them; legends sit outside the data."""
 
 from __future__ import annotations
 
@@ -10,10 +11,20 @@ import numpy as np  # noqa: E402
 
 from sarcover.formulations.instance import TOPInstance  # noqa: E402
 from sarcover.formulations.plan import Plan  # noqa: E402
+from sarcover.reports.style import look  # noqa: E402
 
 
-def plot_plan(instance: TOPInstance, plan: Plan | None, ax=None, title: str | None = None):
-    """The paper's Fig. 2: base, targets, viewpoints (covered filled, missed hollow), routes."""
+def save_figure(fig, path, dpi: int = 110) -> None:
+    """Save ``fig`` to ``path`` with the legends outside its axes in the picture, and close it."""
+    fig.savefig(path, dpi=dpi, bbox_inches="tight")
+    plt.close(fig)
+
+
+def plot_plan(instance: TOPInstance, plan: Plan | None, ax=None, title: str | None = None, legend: bool = True):
+    """The paper's Fig. 2: base, targets, viewpoints (covered filled, missed hollow), routes.
+
+    The legend sits to the right of the axes; ``legend=False`` leaves it to the caller (one for a
+    figure of panels: :func:`plan_legend`)."""
     if ax is None:
         _, ax = plt.subplots(figsize=(7, 7))
     visited = set(plan.visited) if plan is not None else set()
@@ -29,20 +40,32 @@ def plot_plan(instance: TOPInstance, plan: Plan | None, ax=None, title: str | No
     if not instance.same_depot:
         ax.scatter(*instance.end, marker="D", c="k", s=60, label="end depot", zorder=5)
     colors = plt.get_cmap("tab10")
+    what = "UAV" if instance.kind == "sar" else "vehicle"
     if plan is not None:
         for r, route in enumerate(plan.routes):
             if not route:
                 continue
             path = np.vstack([instance.start, pts[list(route)], instance.end])
             ax.plot(path[:, 0], path[:, 1], "-", color=colors(r % 10), lw=1.4,
-                    label=f"UAV {r + 1}", zorder=2)
+                    label=f"{what} {r + 1}", zorder=2)
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x (m)" if instance.kind == "sar" else "x")
     ax.set_ylabel("y (m)" if instance.kind == "sar" else "y")
     if title:
         ax.set_title(title)
-    ax.legend(loc="best", fontsize=7, framealpha=0.8)
+    if legend:
+        ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, fontsize=7, frameon=False)
     return ax
+
+
+def plan_legend(fig, axes) -> None:
+    """One legend for a figure of :func:`plot_plan` panels, below them: every entry of any panel once."""
+    seen: dict[str, object] = {}
+    for ax in axes:
+        for handle, label in zip(*ax.get_legend_handles_labels()):
+            seen.setdefault(label, handle)
+    fig.legend(list(seen.values()), list(seen), loc="lower center", ncol=min(len(seen), 8), fontsize=9,
+               frameon=False)
 
 
 def plot_anytime(series: dict, ax=None, title: str | None = None, reference: float | None = None,
@@ -51,19 +74,20 @@ def plot_anytime(series: dict, ax=None, title: str | None = None, reference: flo
 
     ``series`` maps a method name to its history ``[[t, incumbent, bound], ...]`` (see
     :mod:`sarcover.formulations.history`; None where a value is not known yet). The incumbent is a solid
-    step line, the bound a dashed one, each drawn from its first known value and ending in a
-    marker; ``reference`` (a proven or published optimum) is a thin grey dotted line; ``colors``
-    (method -> colour) keeps colours fixed across panels; ``legend=False`` leaves the legend to
-    the caller (one for a figure of panels). Time is on a symlog axis (linear below
+    step line, the bound a dashed one, each drawn from its first known value and ending in the
+    method's marker (filled for the incumbent, open for the bound); ``reference`` (a proven or
+    published optimum) is a thin grey dotted line; each method has its colour of
+    :mod:`sarcover.reports.style` unless ``colors`` (method -> colour) says otherwise; the legend
+    sits to the right of the axes, and ``legend=False`` leaves it to the caller (one for a
+    figure of panels). Time is on a symlog axis (linear below
     1 s). The y range follows the bounds and the final incumbents, so a trivial early incumbent
     (0) does not flatten the curves; it enters from below.
     """
     if ax is None:
         _, ax = plt.subplots(figsize=(6.5, 4.2))
-    cmap = plt.get_cmap("tab10")
     lows, highs, t_max, used = [], [], 0.0, {}
-    for k, (method, points) in enumerate(series.items()):
-        c = used[method] = (colors or {}).get(method, cmap(k % 10))
+    for method, points in series.items():
+        c = used[method] = (colors or {}).get(method, look(method).color)
         for col, style in ((1, "-"), (2, "--")):
             pts = [(float(p[0]), float(p[col])) for p in points if p[col] is not None]
             if not pts:
@@ -71,7 +95,8 @@ def plot_anytime(series: dict, ax=None, title: str | None = None, reference: flo
             t, v = zip(*pts)
             t_max = max(t_max, t[-1])
             ax.step(t, v, where="post", ls=style, color=c, lw=1.5 if col == 1 else 1.2)
-            ax.plot(t[-1:], v[-1:], marker="o" if col == 1 else "v", color=c, ms=4)
+            ax.plot(t[-1:], v[-1:], marker=look(method).marker, color=c, ms=6,
+                    mfc=c if col == 1 else "white")
             (lows if col == 1 else highs).append(v[-1])
             highs.append(max(v) if col == 2 else v[-1])
     if reference is not None and np.isfinite(reference):
@@ -92,16 +117,16 @@ def plot_anytime(series: dict, ax=None, title: str | None = None, reference: flo
     if title:
         ax.set_title(title, fontsize=10)
     if legend:
-        ax.legend(handles=anytime_legend(used, reference is not None and np.isfinite(reference)), fontsize=6,
-                  loc="best")
+        ax.legend(handles=anytime_legend(used, reference is not None and np.isfinite(reference)), fontsize=7,
+                  loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, frameon=False)
     return ax
 
 
 def anytime_legend(colors: dict, optimum: bool = True) -> list:
-    """Legend handles for :func:`plot_anytime`: one per method (its colour), then the line styles."""
+    """Legend handles for :func:`plot_anytime`: one per method (its colour and marker), then the line styles."""
     from matplotlib.lines import Line2D
 
-    handles = [Line2D([], [], color=c, lw=2, label=m) for m, c in colors.items()]
+    handles = [Line2D([], [], color=c, lw=2, marker=look(m).marker, label=m) for m, c in colors.items()]
     handles += [Line2D([], [], color="k", ls="-", label="incumbent"),
                 Line2D([], [], color="k", ls="--", label="bound")]
     if optimum:

@@ -22,15 +22,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from sarcover.reports.plots import save_figure  # noqa: E402
 from sarcover.reports.results import load_results  # noqa: E402
+from sarcover.reports.style import PAPER, PEERS, dodge, legend_outside, look  # noqa: E402
 
-PAPER = ["adpc-pso", "dpc-pso", "kmeans-pso", "adpc-ga", "adpc-aco"]
-PEERS = ["pyvrp", "routing", "greedy"]
-ORDER = PAPER + PEERS
+ORDER = PAPER + PEERS  # the heuristics, in the order of every table and legend
 LONG_BP = "bp-300s"  # bp rows of the suite paper-gaps-long
-STYLE = {"adpc-pso": ("tab:red", "o", "-"), "dpc-pso": ("tab:blue", "s", "-"), "kmeans-pso": ("tab:green", "^", "-"),
-         "adpc-ga": ("tab:orange", "v", "-"), "adpc-aco": ("tab:purple", "D", "-"), "pyvrp": ("k", "*", "--"),
-         "routing": ("0.4", "x", "--"), "greedy": ("0.6", ".", ":")}
 # Paper Table I (M = 20, N = 5, K = 3), seconds
 PAPER_TABLE1 = {"KMeans": 3.24, "DPC": 0.41, "ADPC": 1.03, "GA": 18.2, "ACO": 497.0, "PSO": 78.3}
 
@@ -79,21 +76,21 @@ def _sweep(df: pd.DataFrame, x: str, out: Path, name: str, title: str, peers: pd
     tab = pd.DataFrame({"mean": g["cov0"].mean(), "ci95": g["cov0"].apply(_ci), "runs": g.size(),
                         "with_plan": g["has_plan"].mean()}).reset_index()
     tab.to_csv(out / f"{name}.csv", index=False)
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    for m in [m for m in ORDER if m in set(tab["method"])]:
+    fig, ax = plt.subplots(figsize=(8.5, 4.5))
+    methods = [m for m in ORDER if m in set(tab["method"])]
+    shift = dodge(methods, 0.05)  # equal means side by side (x is a count: N or K)
+    runs = {}
+    for m in methods:
         t = tab[tab["method"] == m]
-        c, mk, ls = STYLE[m]
-        n = int(t["runs"].min())
-        ax.errorbar(t[x], t["mean"], yerr=t["ci95"], color=c, marker=mk, ls=ls, capsize=3,
-                    label=f"{m} ({n} runs)" if m not in PAPER else m)
+        runs[m] = int(t["runs"].min())
+        ax.errorbar(t[x] + shift[m], t["mean"], yerr=t["ci95"], capsize=3, **look(m).line())
     ax.set_xlabel(x)
+    ax.set_xticks(sorted(tab[x].unique()))
     ax.set_ylabel("coverage (mean, 95% CI)")
     ax.set_title(title)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out / f"{name}.png", dpi=110)
-    plt.close(fig)
+    legend_outside(ax, methods, label=lambda m: m if m in PAPER else f"{m} ({runs[m]} runs)")
+    save_figure(fig, out / f"{name}.png")
     return tab.pivot(index="method", columns=x, values="mean").reindex([m for m in ORDER if m in set(tab["method"])])
 
 
@@ -283,20 +280,21 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
         t = pd.DataFrame({"mean": g["cov0"].mean(), "ci95": g["cov0"].apply(_ci), "runs": g.size(),
                           "with_plan": g["has_plan"].mean()}).reset_index()
         t.to_csv(out / "coverage_vs_emax.csv", index=False)
-        fig, ax = plt.subplots(figsize=(7, 4.5))
-        for m in [m for m in ORDER if m in set(t["method"])]:
+        fig, ax = plt.subplots(figsize=(8.5, 4.5))
+        methods = [m for m in ORDER if m in set(t["method"])]
+        budgets = sorted(t["e_max"].unique())
+        shift = dodge(methods, 0.05 * (min(np.diff(budgets)) if len(budgets) > 1 else 1.0))
+        runs = {}
+        for m in methods:
             s = t[t["method"] == m]
-            c, mk, ls = STYLE[m]
-            ax.errorbar(s["e_max"], s["mean"], yerr=s["ci95"], color=c, marker=mk, ls=ls, capsize=3,
-                        label=f"{m} ({int(s['runs'].min())} runs)")
+            runs[m] = int(s["runs"].min())
+            ax.errorbar(s["e_max"] + shift[m], s["mean"], yerr=s["ci95"], capsize=3, **look(m).line())
         ax.set_xlabel("E_max (energy per UAV)")
         ax.set_ylabel("coverage (mean, 95% CI)")
         ax.set_title("Coverage against E_max (M=20, N=5, K=3)")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(out / "coverage_vs_emax.png", dpi=110)
-        plt.close(fig)
+        legend_outside(ax, methods, label=lambda m: f"{m} ({runs[m]} runs)")
+        save_figure(fig, out / "coverage_vs_emax.png")
         piv = t.pivot(index="method", columns="e_max", values="mean").reindex([m for m in ORDER if m in set(t["method"])])
         pp = piv.loc[[m for m in PAPER if m in piv.index]]
         bestm = {c: (pp[c].idxmax() if pp[c].max() - pp[c].min() > 1e-9 else "all equal") for c in pp.columns}
@@ -526,7 +524,7 @@ def _routes(pk: pd.DataFrame, peers: pd.DataFrame | None, out: Path) -> list[str
     from sarcover.formulations.generate import generate
     from sarcover.formulations.instance import to_top
     from sarcover.formulations.plan import Plan
-    from sarcover.reports.plots import plot_plan
+    from sarcover.reports.plots import plan_legend, plot_plan
 
     pick = "sar-m20-k3-n5-s0"
     rows = pd.concat([pk] + ([peers] if peers is not None else []), ignore_index=True)
@@ -535,14 +533,14 @@ def _routes(pk: pd.DataFrame, peers: pd.DataFrame | None, out: Path) -> list[str
         return []
     rows = rows.set_index("method").reindex([m for m in ORDER if m in set(rows["method"])])
     inst = to_top(generate(20, 3, 5, 0))
-    fig, axes = plt.subplots(2, 4, figsize=(20, 10), squeeze=False)
+    fig, axes = plt.subplots(2, 4, figsize=(20, 10.6), squeeze=False)
     for ax, (m, r) in zip(axes.flat, rows.iterrows()):
-        plot_plan(inst, Plan.of(r["routes"]), ax=ax, title=f"{m}: coverage {100 * r['coverage']:.1f}%")
+        plot_plan(inst, Plan.of(r["routes"]), ax=ax, title=f"{m}: coverage {100 * r['coverage']:.1f}%",
+                  legend=False)
     for ax in list(axes.flat)[len(rows):]:
         ax.axis("off")
-    fig.suptitle(f"Example routes (paper Fig. 2) on {pick}", fontsize=13)
-    fig.tight_layout()
-    fig.savefig(out / "example_routes.png", dpi=80)
-    plt.close(fig)
+    fig.tight_layout(rect=(0, 0.06, 1, 1))  # the panel titles name the methods, the text the instance
+    plan_legend(fig, list(axes.flat)[:len(rows)])
+    save_figure(fig, out / "example_routes.png", dpi=80)
     return ["## Example routes (paper Fig. 2)", "", f"Instance {pick} (M=20, K=3, N=5, seed 0), every method's plan.",
             "", "![example routes](example_routes.png)", ""]

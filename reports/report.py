@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import html
 import json
+import os
 from pathlib import Path
 
 import matplotlib
@@ -20,8 +21,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from sarcover.formulations.records import RESULTS_FILE  # noqa: E402
 from sarcover.reports.gaps import add_gaps, instance_table, method_table  # noqa: E402
+from sarcover.reports.plots import save_figure  # noqa: E402
 from sarcover.reports.results import load_results  # noqa: E402
+from sarcover.reports.style import dodge, legend_outside, look, ordered  # noqa: E402
 
 _PCT = ("gap_mean", "gap_median", "gap_max", "share_optimal", "gap_ub_mean", "gap_ub_median",
         "gap_ub_max", "coverage_mean")
@@ -105,10 +109,11 @@ def _md_table(df: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
-def _save(fig, out: Path, name: str) -> str:
-    fig.tight_layout()
-    fig.savefig(out / name, dpi=110)
-    plt.close(fig)
+def _save(fig, out: Path, name: str, layout: bool = True) -> str:
+    """Save ``out/name`` (laid out first unless the caller did) and return ``name``."""
+    if layout:
+        fig.tight_layout()
+    save_figure(fig, out / name)
     return name
 
 
@@ -121,16 +126,20 @@ def _coverage_against(sar: pd.DataFrame, x: str, fixed: tuple[str, str], out: Pa
             continue
         piv = g.pivot_table(index="method", columns=x, values="coverage", aggfunc="mean")
         runs = g.groupby(x)["instance"].nunique()
-        fig, ax = plt.subplots(figsize=(6.5, 4.2))
-        for method, vals in piv.iterrows():
-            ax.plot(vals.index, vals.values, marker="o", label=method)
+        fig, ax = plt.subplots(figsize=(7.5, 4.2))
+        xs = list(piv.columns)
+        gap = min(np.diff(xs)) if len(xs) > 1 else 1.0
+        shift = dodge(piv.index, 0.5 * gap / max(len(piv.index), 1))  # equal values side by side
+        for method in ordered(piv.index):
+            vals = piv.loc[method]
+            ax.plot(vals.index + shift[method], vals.values, ms=6, lw=1.3, label=method, **look(method).line())
         ax.set_xlabel(x)
         ax.set_ylabel("mean coverage")
-        ax.set_xticks(list(piv.columns))
+        ax.set_xticks(xs)
         n_runs = f"{runs.min()}" if runs.min() == runs.max() else f"{runs.min()}–{runs.max()}"
-        ax.set_title(f"Coverage against {x} ({a}={va}, {b}={vb}; {n_runs} instances per point)")
+        ax.set_title(f"Coverage against {x} ({a}={va}, {b}={vb}; {n_runs} instances per point)", fontsize=10)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
+        legend_outside(ax, piv.index)
         name = _save(fig, out, f"coverage_vs_{x}_{a}{va}_{b}{vb}.png")
         csv = f"coverage_vs_{x}_{a}{va}_{b}{vb}.csv"
         piv.to_csv(out / csv)
@@ -145,7 +154,9 @@ def _coverage_against(sar: pd.DataFrame, x: str, fixed: tuple[str, str], out: Pa
     if tables:
         doc.h(f"Coverage against {x} (paper Fig. {fig_no})")
         doc.p(f"Mean coverage (covered viewpoints / M·K) over the runs with a plan, {a} and {b} fixed; in "
-              f"parentheses the share of runs that found a plan covering every target, where below 100%.")
+              f"parentheses the share of runs that found a plan covering every target, where below 100%. "
+              f"In the plot each method's points sit slightly apart around each {x}, so that equal values "
+              f"stay visible.")
         for va, vb, name, csv, piv in tables:
             doc.img(name, f"coverage against {x}, {a}={va}, {b}={vb}")
             doc.table(piv.rename_axis("method"), csv)
@@ -168,7 +179,7 @@ def _example_routes(df: pd.DataFrame, out: Path, doc: _Doc):
     from sarcover.formulations.io import load_instance
     from sarcover.formulations.plan import Plan
 
-    from sarcover.reports.plots import plot_plan
+    from sarcover.reports.plots import plan_legend, plot_plan
 
     ok = df[df["valid"].astype(bool) & df["routes"].notna()]
     if ok.empty:
@@ -192,14 +203,17 @@ def _example_routes(df: pd.DataFrame, out: Path, doc: _Doc):
     rows = rows.head(12)
     cols = min(3, len(rows))
     nrows = int(np.ceil(len(rows) / cols))
-    fig, axes = plt.subplots(nrows, cols, figsize=(5 * cols, 5 * nrows), squeeze=False)
+    rows = rows.set_index("method").loc[ordered(rows["method"])].reset_index()
+    fig, axes = plt.subplots(nrows, cols, figsize=(5 * cols, 5 * nrows + 0.6), squeeze=False)
     for ax, (_, r) in zip(axes.flat, rows.iterrows()):
         cov = f"{100 * r['coverage']:.1f}%" if pd.notna(r["coverage"]) else "-"
-        plot_plan(instance, Plan.of(r["routes"]), ax=ax, title=f"{r['method']} ({r['status']}): coverage {cov}")
+        plot_plan(instance, Plan.of(r["routes"]), ax=ax, title=f"{r['method']} ({r['status']}): coverage {cov}",
+                  legend=False)
     for ax in list(axes.flat)[len(rows):]:
         ax.axis("off")
-    fig.suptitle(f"Example routes on {pick}", fontsize=13)
-    name = _save(fig, out, "example_routes.png")
+    fig.tight_layout(rect=(0, 0.6 / (5 * nrows + 0.6), 1, 1))  # the panel titles name the methods; the
+    plan_legend(fig, list(axes.flat)[:len(rows)])                # text above names the instance
+    name = _save(fig, out, "example_routes.png", layout=False)
     doc.h("Example routes (paper Fig. 2)")
     doc.p(f"Instance {pick}: the plan of each method (seed {int(rows.iloc[0]['seed'])}).")
     doc.img(name, f"routes on {pick}")
@@ -209,14 +223,25 @@ def _gap_distributions(gapped: pd.DataFrame, out: Path, doc: _Doc):
     made = []
     for col, label in (("gap", "gap to proven optimum"), ("gap_ub", "gap to best bound (upper bound on true gap)")):
         data = {m: 100 * g[col].dropna().to_numpy() for m, g in gapped.groupby("method", sort=False)}
-        data = {m: v for m, v in data.items() if len(v)}
+        data = {m: data[m] for m in ordered(data) if len(data[m])}
         if not data:
             continue
         fig, ax = plt.subplots(figsize=(max(6, 0.8 * len(data) + 2), 4.2))
-        ax.boxplot(list(data.values()), showmeans=True)
+        box = ax.boxplot(list(data.values()), showmeans=True, patch_artist=True,
+                         medianprops={"color": "k"}, flierprops={"markeredgecolor": "0.4"})
+        for m, patch, mean in zip(data, box["boxes"], box["means"]):  # each method in its colour
+            lk = look(m)
+            patch.set(facecolor=lk.color, alpha=0.35, edgecolor=lk.color)
+            mean.set(marker=lk.marker, markerfacecolor=lk.color, markeredgecolor="k")
         ax.set_xticks(range(1, len(data) + 1), list(data.keys()), rotation=30, ha="right")
+        for tick, m in zip(ax.get_xticklabels(), data):
+            tick.set_color(look(m).color)
+        groups = [look(m).group for m in data]
+        for i in range(1, len(groups)):  # a thin rule between the paper's methods, the peers, the exact ones
+            if groups[i] != groups[i - 1]:
+                ax.axvline(i + 0.5, color="0.6", lw=0.8, ls=":")
         ax.set_ylabel(f"{label} (%)" if col == "gap" else "gap to best bound (%)")
-        ax.set_title(f"{label.capitalize()}, per method (triangle: mean)")
+        ax.set_title(f"{label.capitalize()}, per method (marker: mean)", fontsize=10)
         ax.grid(alpha=0.3, axis="y")
         made.append((_save(fig, out, f"{col}_distribution.png"), label))
     if made:
@@ -229,20 +254,28 @@ def _time_to_optimality(gapped: pd.DataFrame, out: Path, doc: _Doc):
     ex = gapped[gapped["exact"].astype(bool)]
     if ex.empty:
         return
-    fig, ax = plt.subplots(figsize=(6.5, 4.2))
-    colors = plt.get_cmap("tab10")
-    for i, (m, g) in enumerate(ex.groupby("method")):
+    from matplotlib.lines import Line2D
+
+    fig, ax = plt.subplots(figsize=(7.5, 4.2))
+    methods = ordered(ex["method"].unique())
+    sizes = sorted(ex["n_nodes"].unique())
+    gap = min(np.diff(sizes)) if len(sizes) > 1 else 1.0
+    shift = dodge(methods, 0.4 * gap / max(len(methods), 1))
+    for m in methods:
+        g = ex[ex["method"] == m]
+        lk = look(m)
         opt = g[g["status"] == "optimal"]
         rest = g[g["status"] != "optimal"]
-        ax.scatter(opt["n_nodes"], opt["runtime_s"], color=colors(i % 10), label=f"{m} optimal", s=22)
-        if len(rest):
-            ax.scatter(rest["n_nodes"], rest["runtime_s"], color=colors(i % 10), marker="x", s=28,
-                       label=f"{m} not proven")
+        ax.scatter(opt["n_nodes"] + shift[m], opt["runtime_s"], color=lk.color, marker=lk.marker, s=30)
+        ax.scatter(rest["n_nodes"] + shift[m], rest["runtime_s"], facecolors="none", edgecolors=lk.color,
+                   marker=lk.marker, s=30)
     ax.set_yscale("log")
     ax.set_xlabel("nodes (viewpoints)")
     ax.set_ylabel("runtime (s)")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
+    legend_outside(ax, methods, extra=[
+        (Line2D([], [], ls="none", marker="o", color="0.3"), "filled: proven optimal"),
+        (Line2D([], [], ls="none", marker="o", mfc="none", color="0.3"), "open: not proven")])
     name = _save(fig, out, "time_to_optimality.png")
     tab = ex.groupby(["method", "n_nodes"]).agg(runs=("status", "size"),
                                                  optimal=("status", lambda s: int((s == "optimal").sum())),
@@ -250,7 +283,7 @@ def _time_to_optimality(gapped: pd.DataFrame, out: Path, doc: _Doc):
                                                  runtime_max_s=("runtime_s", "max"))
     tab.to_csv(out / "time_to_optimality.csv")
     doc.h("Time to optimality against size (exact methods)")
-    doc.p("Dots: proven optimal; crosses: stopped without proof (time limit, error).")
+    doc.p("Filled markers: proven optimal; open markers: stopped without proof (time limit, error).")
     doc.img(name, "time to optimality against size")
     tab = tab.reset_index()
     tab.index = [f"{m} n={n}" for m, n in zip(tab.pop("method"), tab.pop("n_nodes"))]
@@ -290,8 +323,8 @@ def _anytime(df: pd.DataFrame, inst: pd.DataFrame, out: Path, doc: _Doc):
     pick = sorted(series, key=lambda i: (-len(series[i]), i))[:ANYTIME_PANELS]
     cols = min(3, len(pick))
     nrows = int(np.ceil(len(pick) / cols))
-    methods = sorted({m for i in pick for m in series[i]})
-    colors = {m: plt.get_cmap("tab10")(k % 10) for k, m in enumerate(methods)}
+    methods = ordered({m for i in pick for m in series[i]})
+    colors = {m: look(m).color for m in methods}
     fig, axes = plt.subplots(nrows, cols, figsize=(5.2 * cols, 3.8 * nrows), squeeze=False)
     for ax, name in zip(axes.flat, pick):
         ref = inst["opt"].get(name, np.nan) if "opt" in inst else np.nan
@@ -300,12 +333,9 @@ def _anytime(df: pd.DataFrame, inst: pd.DataFrame, out: Path, doc: _Doc):
     for ax in list(axes.flat)[len(pick):]:
         ax.axis("off")
     handles = anytime_legend(colors, optimum=bool(inst["opt"].reindex(pick).notna().any()))  # one for all panels
-    fig.suptitle("Bound and incumbent against time (exact methods)", fontsize=12)
-    fig.tight_layout(rect=(0, 0.07 if nrows == 1 else 0.04, 1, 1))
+    fig.tight_layout(rect=(0, 0.07 if nrows == 1 else 0.04, 1, 1))  # panel titles name the instances
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
-    fig.savefig(out / "anytime.png", dpi=110)
-    plt.close(fig)
-    name = "anytime.png"
+    name = _save(fig, out, "anytime.png", layout=False)
     flat = [{"instance": i, "method": m, "t_s": p[0], "incumbent": p[1], "bound": p[2]}
             for i in pick for m, pts in series[i].items() for p in pts]
     pd.DataFrame(flat).to_csv(out / "anytime.csv", index=False)
@@ -332,6 +362,12 @@ def _parquet(df: pd.DataFrame, path: Path) -> bool:
         return False
 
 
+def _relative(path, start) -> str:
+    """``path`` relative to ``start`` (the results folder as seen from the report's folder: ``..``
+    for the default RESULTS/report), so that the report names no machine's absolute paths."""
+    return Path(os.path.relpath(Path(path).resolve(), Path(start).resolve())).as_posix()
+
+
 def write_report(results_dir: str | Path, out_dir: str | Path) -> str:
     """Write report.md, report.html, PNGs and CSVs into ``out_dir``; return a one-line summary."""
     df, skipped = load_results(results_dir)
@@ -346,7 +382,8 @@ def write_report(results_dir: str | Path, out_dir: str | Path) -> str:
     n_opt = int(inst["opt"].notna().sum())
     doc.p(f"{len(df)} runs: {df['instance'].nunique()} instances × {df['method'].nunique()} methods; "
           f"{n_opt} instances with a proven optimum, {int((inst['opt'].isna() & inst['best_bound'].notna()).sum())} "
-          f"with a bound only. Source: {Path(results_dir).resolve()}.")
+          f"with a bound only. Source: `{RESULTS_FILE}` of the results folder `{_relative(results_dir, out)}` "
+          f"(paths relative to this report's folder).")
     bad = {k: v for k, v in skipped.items() if v}
     if bad:
         doc.p("Skipped rows: " + ", ".join(f"{v} {k.replace('_', ' ')}" for k, v in bad.items())

@@ -60,3 +60,13 @@ def interrupted(instance, *, seed=0, time_limit=None):
     signal.signal(signal.SIGINT, signal.SIG_DFL)
     os.kill(os.getpid(), signal.SIGINT)
     time.sleep(5.0)
+
+
+def marked(instance, *, seed=0, time_limit=None):
+    """Leaves a mark (a file named instance.pid in $SARCOVER_TEST_MARKS) as it starts, sleeps 1.5 s,
+    then visits every node: a test can see which worker process runs which job, and kill it mid-job."""
+    from pathlib import Path
+
+    (Path(os.environ["SARCOVER_TEST_MARKS"]) / f"{instance.name}.{os.getpid()}").touch()
+    time.sleep(1.5)
+    return all_optimal(instance)

@@ -59,12 +59,13 @@ def test_methods_lists_greedy_as_heuristic(capsys):
 
 
 def test_infeasible_instance_is_a_status(tmp_path):
-    """An E_max too small for any view is status infeasible with the target named, exit 0."""
+    """An E_max too small for any view is status infeasible with the target named, exit code 3
+    (no plan); the JSON object still comes out."""
     inst = tmp_path / "i.json"
     main(["generate", "-M", "4", "-K", "2", "-N", "1", "--e-max", "50", "-o", str(inst)])
     out = run("solve", str(inst), "--json")
     rec = json.loads(out.stdout)
-    assert out.returncode == 0 and rec["status"] == "infeasible" and "target 0" in rec["reason"]
+    assert out.returncode == 3 and rec["status"] == "infeasible" and "target 0" in rec["reason"]
 
 
 @pytest.mark.parametrize(
