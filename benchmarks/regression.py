@@ -1,10 +1,16 @@
-"""Regression table of proven optimal values, confirmed by both exact solvers (`milp`, `cpsat`).
+"""Regression table of proven optimal values, each confirmed by two independent sources.
 
-``python -m sarcover.benchmarks.regression [--time-limit S] [--random N]`` re-solves every instance of the
-table with both methods and rewrites ``benchmarks/regression/optimal_values.csv``; a row is kept
-only if both proved optimality and agree (or both proved infeasibility). Instances are either
-generated (``gen:M,K,N,seed,e_max`` with the paper preset) or TOP benchmark files (``top:p2.2.k``).
-:func:`random_cases` is also the instance family of the exact cross-check test.
+A row's ``confirmed_by`` names them: ``milp+cpsat`` (both solvers proved the same value, or both
+proved infeasibility), ``bp+milp`` / ``bp+cpsat`` (branch-and-price and a compact model agree, for
+instances too large for the other compact model), or ``bp+published`` (bp proved the optimum that
+the TOP literature publishes as proven, ``instances/top/optimal.csv``).
+
+``python -m sarcover.benchmarks.regression [--time-limit S] [--random N]`` re-solves the small
+instances of the table with milp and cpsat and rewrites its ``milp+cpsat`` rows, keeping the
+others; ``--add SPEC ... --by bp+published|bp+milp|bp+cpsat`` confirms further instances and adds
+them. Instances are either generated (``gen:M,K,N,seed,e_max`` with the paper preset) or TOP
+benchmark files (``top:p2.2.k``). :func:`random_cases` is also the instance family of the exact
+cross-check test.
 """
 
 from __future__ import annotations
@@ -20,10 +26,12 @@ from sarcover.formulations.generate import generate
 from sarcover.formulations.instance import TOPInstance, to_top
 from sarcover.formulations.io import read_top
 
+from sarcover.benchmarks.catalog import TOP_DIR, published
+
 ROOT = Path(__file__).resolve().parent
 TABLE = ROOT / "regression" / "optimal_values.csv"
-TOP_DIR = ROOT / "instances" / "top"
-FIELDS = ["spec", "status", "value", "milp_s", "cpsat_s"]
+FIELDS = ["spec", "status", "value", "confirmed_by", "milp_s", "cpsat_s", "bp_s"]
+SOURCES = ("milp+cpsat", "bp+milp", "bp+cpsat", "bp+published")
 
 # TOP files both solvers prove quickly (sets 1-3, 1 thread).
 TOP_SPECS = ["p2.2.a", "p2.2.d", "p2.2.j", "p2.3.g", "p2.4.k", "p1.2.d", "p1.2.f", "p1.3.g",
@@ -65,39 +73,83 @@ def load_spec(spec: str) -> TOPInstance:
 
 
 def read_table(path: Path = TABLE) -> list[dict]:
+    """The table's rows; rows written before ``confirmed_by`` existed are ``milp+cpsat`` rows."""
     with open(path, newline="") as fh:
-        return list(csv.DictReader(fh))
+        rows = list(csv.DictReader(fh))
+    for row in rows:
+        row["confirmed_by"] = row.get("confirmed_by") or "milp+cpsat"
+        row.setdefault("bp_s", "")
+    return rows
 
 
-def confirm(spec: str, time_limit: float) -> dict | None:
-    """Solve with both exact methods; the row if both proved the same thing, else None."""
+def write_table(rows: list[dict], path: Path = TABLE) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=FIELDS, extrasaction="ignore")
+        w.writeheader()
+        w.writerows({k: row.get(k, "") for k in FIELDS} for row in rows)
+
+
+def published_optimum(spec: str) -> float | None:
+    """The optimum the literature publishes as proven for a ``top:`` spec, else None."""
+    kind, _, body = spec.partition(":")
+    if kind != "top":
+        return None
+    value = published(TOP_DIR / f"{body}.txt")
+    return value[0] if value is not None and value[1] == "optimal" else None
+
+
+def confirm(spec: str, time_limit: float, by: str = "milp+cpsat") -> dict | None:
+    """Solve ``spec`` with the two sources ``by`` names; the row if both give the same proven
+    answer, else None (with the reason on stderr). A bp proof that differs from a published
+    optimum is reported as a conflict: that is a bug until shown otherwise."""
     from sarcover.benchmarks.registry import run_method  # the CLI side; formulations never import this
 
+    if by not in SOURCES:
+        raise ValueError(f"unknown confirmation {by!r}; expected one of {', '.join(SOURCES)}")
     inst = load_spec(spec)
-    out = {}
-    for name in ("milp", "cpsat"):
-        res = run_method(name, inst, time_limit=time_limit)
-        out[name] = res
-    a, b = out["milp"], out["cpsat"]
-    row = {"spec": spec, "milp_s": f"{a.runtime_s:.3f}", "cpsat_s": f"{b.runtime_s:.3f}"}
-    if a.status == b.status == "infeasible":
+    methods = [m for m in by.split("+") if m != "published"]
+    out = {m: run_method(m, inst, time_limit=time_limit) for m in methods}
+    row = {"spec": spec, "confirmed_by": by, **{f"{m}_s": f"{r.runtime_s:.3f}" for m, r in out.items()}}
+    answers = [(r.status, r.objective) for r in out.values()]
+    if by.endswith("+published"):
+        value = published_optimum(spec)
+        if value is None:
+            print(f"{spec}: no published optimum to confirm against", file=sys.stderr)
+            return None
+        answers.append(("optimal", value))
+    statuses = {a[0] for a in answers}
+    if statuses == {"infeasible"}:
         return {**row, "status": "infeasible", "value": ""}
-    if a.status == b.status == "optimal" and abs(a.objective - b.objective) <= 1e-9:
-        return {**row, "status": "optimal", "value": f"{a.objective:g}"}
-    print(f"{spec}: not confirmed (milp {a.status} {a.objective}, cpsat {b.status} {b.objective})",
-          file=sys.stderr)
+    values = [a[1] for a in answers]
+    if statuses == {"optimal"} and max(values) - min(values) <= 1e-9:
+        return {**row, "status": "optimal", "value": f"{values[0]:g}"}
+    what = ", ".join(f"{m} {r.status} {r.objective}" for m, r in out.items())
+    if by.endswith("+published"):
+        what += f", published {answers[-1][1]:g}"
+        if out["bp"].status == "optimal":
+            what = "CONFLICT: " + what
+    print(f"{spec}: not confirmed ({what})", file=sys.stderr)
     return None
 
 
 def regenerate(time_limit: float = 60.0, n_random: int = 40, path: Path = TABLE) -> list[dict]:
-    """Re-solve the table's instances with both methods and write the confirmed rows."""
+    """Re-solve the small instances with milp and cpsat; write their confirmed rows beside the
+    table's rows of other sources."""
     specs = [f"top:{n}" for n in TOP_SPECS] + random_cases(n_random, start=500, max_targets=6, max_views=3)
     rows = [r for r in (confirm(s, time_limit) for s in specs) if r is not None]
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=FIELDS)
-        w.writeheader()
-        w.writerows(rows)
+    kept = [r for r in read_table(path) if r["confirmed_by"] != "milp+cpsat"] if path.exists() else []
+    write_table(rows + kept, path)
+    return rows
+
+
+def add(specs: list[str], by: str, time_limit: float, path: Path = TABLE) -> list[dict]:
+    """Confirm ``specs`` by ``by`` and add the confirmed rows to the table (replacing rows of the
+    same spec)."""
+    rows = [r for r in (confirm(s, time_limit, by) for s in specs) if r is not None]
+    new = {r["spec"] for r in rows}
+    old = [r for r in read_table(path) if r["spec"] not in new] if path.exists() else []
+    write_table(old + rows, path)
     return rows
 
 
@@ -106,8 +158,19 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--time-limit", type=float, default=60.0, help="seconds per solver and instance")
     ap.add_argument("--random", type=int, default=40, help="number of generated SAR instances")
     ap.add_argument("--out", type=Path, default=TABLE)
+    ap.add_argument("--add", nargs="+", metavar="SPEC", help="confirm these specs and add them to the table")
+    ap.add_argument("--by", default="bp+published", choices=SOURCES, help="the two sources for --add")
     args = ap.parse_args(argv)
-    rows = regenerate(args.time_limit, args.random, args.out)
+    try:
+        if args.add:
+            for spec in args.add:
+                load_spec(spec)  # a bad spec is a one-line error before anything is solved
+            rows = add(args.add, args.by, args.time_limit, args.out)
+        else:
+            rows = regenerate(args.time_limit, args.random, args.out)
+    except (ValueError, OSError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     print(f"{len(rows)} confirmed rows written to {args.out}")
     return 0
 
