@@ -527,7 +527,7 @@ def _decomposition_section(root: Path, out: Path) -> list[str]:
     intro = ("From the stored rows of the paper-opt suite (`python -m sarcover.benchmarks.reproduce`'s decomposition "
              "step): OPT per instance is bp's proven optimum there, else its certified bound; where OPT is a bound "
              "the gap and the clustering loss are upper bounds (the tables say where).")
-    return [head, "", intro, "", "![gap decomposition](decomposition.png)", rest.lstrip("\n"), ""]
+    return [head, "", intro, "", "![gap decomposition](decomposition.png)", "", rest.lstrip("\n"), ""]
 
 
 def _bp_run_summary(bp: pd.DataFrame) -> str:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 
 import matplotlib
+import matplotlib.figure
 import numpy as np
 import pandas as pd
 import pytest
@@ -189,8 +190,21 @@ def test_top_sets_in_the_reference_report(tmp_path):
     assert (tmp_path / "out" / "top_4_7_sets.csv").stat().st_size > 0
 
 
-def test_decomposition_section_appears_when_its_rows_exist(tmp_path):
+def test_decomposition_section_appears_when_its_rows_exist(tmp_path, monkeypatch):
     from test_reports_decomposition import synthetic_rows
+
+    from sarcover.reports import decomposition
+    from sarcover.reports.style import look
+
+    ticks = {}
+    savefig = matplotlib.figure.Figure.savefig
+
+    def record(fig, path, *args, **kwargs):  # the method names under the bars carry each method's look
+        for ax in fig.axes:
+            ticks.update({t.get_text(): matplotlib.colors.to_hex(t.get_color()) for t in ax.get_xticklabels()})
+        return savefig(fig, path, *args, **kwargs)
+
+    monkeypatch.setattr(decomposition.plt.Figure, "savefig", record)
 
     root = tmp_path / "root"
     text = write_reference(root, tmp_path / "out", suites=SUITES).read_text()
@@ -204,6 +218,8 @@ def test_decomposition_section_appears_when_its_rows_exist(tmp_path):
     assert "### M=20 K=3 N=5" in text and "ADPC's clustering loses less than DPC's" in text
     for name in ("decomposition.png", "decomposition_summary.csv", "decomposition_verdicts.csv"):
         assert (tmp_path / "out" / name).stat().st_size > 0
+    assert set(ticks) == {"adpc-pso", "dpc-pso", "kmeans-pso", "oracle-pso"}
+    assert all(color == look(m).color for m, color in ticks.items())
 
 
 def test_reproduce_runs_paper_opt_then_decomposition_then_top_4_7(tmp_path, monkeypatch):
