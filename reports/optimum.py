@@ -207,11 +207,12 @@ def coverage_table(df: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
 
 def optimum_curve(br: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
     """Per x of the figure with bp rows: mean optimum coverage lo/hi over the instances with an
-    optimum, and whether every one of them is proven."""
-    s = br[(br[sweep.fixed] == sweep.value) & br[sweep.x].isin(sweep.xs) & br["known"]]
-    rows = [{sweep.x: x, "lo": g["lo_cov"].mean(), "hi": g["hi_cov"].mean(), "instances": len(g),
-             "proven": int((g["state"] == "proven").sum())} for x, g in s.groupby(sweep.x)]
-    out = pd.DataFrame(rows, columns=[sweep.x, "lo", "hi", "instances", "proven"])
+    optimum, how many of the setting's instances that is, and whether every one of them is proven."""
+    s = br[(br[sweep.fixed] == sweep.value) & br[sweep.x].isin(sweep.xs)]
+    rows = [{sweep.x: x, "lo": g.loc[g["known"], "lo_cov"].mean(), "hi": g.loc[g["known"], "hi_cov"].mean(),
+             "instances": int(g["known"].sum()), "setting_instances": len(g),
+             "proven": int((g["state"] == "proven").sum())} for x, g in s.groupby(sweep.x) if g["known"].any()]
+    out = pd.DataFrame(rows, columns=[sweep.x, "lo", "hi", "instances", "setting_instances", "proven"])
     out["all_proven"] = out["proven"] == out["instances"]
     return out
 
@@ -245,6 +246,9 @@ def draw_optimum(ax, curve: pd.DataFrame, x: str, width: float = 0.45) -> list:
         ax.plot(xs, y, color=OPT_COLOR, lw=6, alpha=0.45, solid_capstyle="round", marker="_", ms=18,
                 zorder=1, label="optimum")
         extra.append((Line2D([], [], color=OPT_COLOR, lw=6, alpha=0.45), "mean optimum (bp proven)"))
+    for _, r in curve[curve["instances"] < curve["setting_instances"]].iterrows():  # bp still running there
+        ax.annotate(f"optimum on {r['instances']}/{r['setting_instances']}", (r[x], r["hi"]), xytext=(0, 8),
+                    textcoords="offset points", ha="center", fontsize=7, color="0.3")
     return extra
 
 
