@@ -1,24 +1,34 @@
 """Reproduce the paper and write the reference report: ``python -m sarcover.benchmarks.reproduce``.
 
 Runs the built-in suites into ``RESULTS/<suite>`` (default ``results/reference``), resuming whatever
-is already stored there, then writes ``reports/reference/README.md`` with its PNGs and CSVs
-(:func:`sarcover.reports.reference.write_reference`):
+is already stored there, then the gap decomposition, then writes ``reports/reference/README.md``
+with its PNGs and CSVs (:func:`sarcover.reports.reference.write_reference`). Wall times on 2 cores
+(2 workers; the reference run's, or estimates where marked ~):
 
-================  ===================================================================================
-paper-n           Fig. 3: M=20, K=3, N=2..6; the five paper methods + greedy, ``--runs`` per setting
-paper-k           Fig. 4 / Table I: M=20, N=5, K=2..6; same methods
-paper-peers       routing (2 s) and pyvrp (1 s) on the first 20 instances of every setting above
-exact-small       every method on 8-40 viewpoints; milp, cpsat, bp (60 s) prove optima -> gaps
-paper-gaps        M=20, N=5, K=3 and 6 (8 instances each): heuristics against bp's bound (60 s)
-paper-gaps-long   bp at 300 s (subset-row cuts on) on K=3 seed 5 and K=6 seeds 0..3 of paper-gaps
-emax-sweep        coverage against E_max = 4000..9000 at M=20, N=5, K=3 (50 instances per budget)
-table1            Table I timings: M=20, N=5, K=2..6, 30 instances each, on ONE worker
-top-chao          the exact methods (milp, cpsat, bp; 60 s) on TOP sets 1-3 against published optima
-================  ===================================================================================
+================  ========  =========================================================================
+step              wall      what
+================  ========  =========================================================================
+paper-n           5 min     Fig. 3: M=20, K=3, N=2..6; the five paper methods + greedy, ``--runs`` per setting
+paper-k           5 min     Fig. 4 / Table I: M=20, N=5, K=2..6; same methods
+paper-peers       3.5 min   routing (2 s) and pyvrp (1 s) on the first 20 instances of every setting above
+exact-small       10 min    every method on 8-40 viewpoints; milp, cpsat, bp (60 s) prove optima -> gaps
+paper-gaps        6 min     M=20, N=5, K=3 and 6 (8 instances each): heuristics against bp's bound (60 s)
+paper-gaps-long   11 min    bp at 300 s (subset-row cuts on) on K=3 seed 5 and K=6 seeds 0..3 of paper-gaps
+emax-sweep        1.5 min   coverage against E_max = 4000..9000 at M=20, N=5, K=3 (50 instances per budget)
+table1            0.5 min   Table I timings: M=20, N=5, K=2..6, 30 instances each, on ONE worker
+top-chao          32 min    the exact methods (milp, cpsat, bp; 60 s) on TOP sets 1-3 against published optima
+paper-opt         ~3-4 h    the paper's grid (Fig. 3 and 4 settings, 20 instances each): every heuristic
+                            (~5 min) against bp's optimum (60 s at K<=3, 300 s at K=4,5, 600 s at K=6;
+                            up to 3-4 h of the wall)
+decomposition     ~1 h      clustering / cross-cluster / routing loss of the paper methods, from
+                            paper-opt's optima, at N=5 K=3, N=5 K=6 and K=3 N=2..6 (one process)
+top-4-7           ~5-8 h    bp alone at 600 s on the 192 shipped files of TOP sets 4-7 (~10-15 CPU-hours)
+================  ========  =========================================================================
 
 ``--runs R`` sets the random instances per setting of paper-n and paper-k (the paper: 1000, the
-default); ``--skip SUITE`` leaves a suite out; ``--report-only`` only rewrites the report.
-The results directory (raw JSON Lines rows) is not committed; the report's CSVs are.
+default); ``--skip STEP`` leaves a suite or the decomposition out; ``--report-only`` only rewrites
+the report. Every step resumes: a stopped run continues where it stopped. The results directory
+(raw JSON Lines rows) is not committed; the report's CSVs are.
 """
 
 from __future__ import annotations
@@ -29,8 +39,27 @@ import time
 from pathlib import Path
 
 SUITES = ["paper-n", "paper-k", "paper-peers", "exact-small", "paper-gaps", "paper-gaps-long", "emax-sweep",
-          "table1", "top-chao"]
-EXACT_ONLY = {"top-chao": ["milp", "cpsat", "bp"]}  # suites run with only these of their methods
+          "table1", "top-chao", "paper-opt", "top-4-7"]
+EXACT_ONLY = {"top-chao": ["milp", "cpsat", "bp"], "top-4-7": ["bp"]}  # suites run with only these of their methods
+DECOMPOSITION = "decomposition"  # the step after paper-opt: RESULTS/decomposition/rows.jsonl
+DECOMPOSE_FROM = "paper-opt"
+# (K, N) settings of paper-opt to decompose: Fig. 3's K=3 sweep over N and N=5 at K=6
+DECOMPOSE_SETTINGS = [(3, 2), (3, 3), (3, 4), (3, 5), (3, 6), (6, 5)]
+STEPS = SUITES[:SUITES.index(DECOMPOSE_FROM) + 1] + [DECOMPOSITION] + SUITES[SUITES.index(DECOMPOSE_FROM) + 1:]
+
+
+def decompose_step(root: Path, *, quiet: bool = False) -> int:
+    """Decompose the paper methods' gaps on paper-opt's instances of DECOMPOSE_SETTINGS into
+    ``root/decomposition/rows.jsonl`` (resumable: stored rows are skipped); returns the rows there."""
+    from sarcover.benchmarks.decomposition import cases_from_results, decompose
+
+    source = root / DECOMPOSE_FROM
+    if not (source / "results.jsonl").is_file():
+        print(f"{DECOMPOSITION}: no {DECOMPOSE_FROM} results in {source}; skipped", file=sys.stderr)
+        return 0
+    cases = [c for c in cases_from_results(source) if (c.meta.get("K"), c.meta.get("N")) in DECOMPOSE_SETTINGS]
+    rows = decompose(cases, root / DECOMPOSITION / "rows.jsonl", stream=None if quiet else sys.stderr)
+    return len(rows)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -39,7 +68,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default="reports/reference", help="report directory (default reports/reference)")
     ap.add_argument("--runs", type=int, default=1000, help="instances per setting of paper-n/paper-k (default 1000)")
     ap.add_argument("--workers", type=int, help="worker processes (default: all cores)")
-    ap.add_argument("--skip", action="append", default=[], choices=SUITES, help="leave a suite out (repeatable)")
+    ap.add_argument("--skip", action="append", default=[], choices=STEPS,
+                    help="leave a suite or the decomposition out (repeatable)")
     ap.add_argument("--report-only", action="store_true", help="do not run; rewrite the report from stored results")
     ap.add_argument("--quiet", action="store_true", help="no progress bars")
     ap.add_argument("--note", action="append", default=[], help="a paragraph to add to the report (repeatable)")
@@ -51,8 +81,13 @@ def main(argv: list[str] | None = None) -> int:
 
     root = Path(args.results)
     if not args.report_only:
-        for name in SUITES:
+        for name in STEPS:
             if name in args.skip:
+                continue
+            if name == DECOMPOSITION:
+                t0 = time.monotonic()
+                n = decompose_step(root, quiet=args.quiet)
+                print(f"{name}: {n} rows in {time.monotonic() - t0:.0f} s", file=sys.stderr)
                 continue
             runs = args.runs if name in ("paper-n", "paper-k") else None
             suite = load_suite(name, runs=runs, methods=EXACT_ONLY.get(name))

@@ -27,6 +27,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from sarcover.reports.style import look  # noqa: E402
+
 PARTS = [("clustering_loss", "clustering loss", "tab:blue"),
          ("cross_cluster", "cross-cluster part (repair/refill moves)", "tab:gray"),
          ("routing_loss", "routing loss", "tab:orange")]
@@ -151,6 +153,8 @@ def plot_decomposition(tab: pd.DataFrame, path: Path) -> None:
         ax.plot(x, t["gap_pct"], "k.", label="gap")
         ax.axhline(0, color="k", lw=0.6)
         ax.set_xticks(x, methods, rotation=45, ha="right", fontsize=8)
+        for tick in ax.get_xticklabels():  # the bars are coloured by part, so the method names carry its look
+            tick.set_color(look(tick.get_text()).color)
         ax.set_title(f"{setting} ({int(t['instances'].max())} inst.)", fontsize=9)
         ax.grid(axis="y", alpha=0.3)
     axes[0][0].set_ylabel("mean loss, % of OPT")

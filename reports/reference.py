@@ -2,8 +2,12 @@
 
 ``write_reference(results_root, out_dir)`` reads the result directories that
 ``python -m sarcover.benchmarks.reproduce`` fills (one per suite: paper-n, paper-k, paper-peers, exact-small,
-paper-gaps, paper-gaps-long, emax-sweep, table1, top-chao; any may be missing) and writes ``out_dir/README.md`` with PNG figures and CSV
-tables beside it. Every number in the text is computed here from the stored rows.
+paper-gaps, paper-gaps-long, emax-sweep, table1, top-chao, paper-opt, top-4-7; any may be missing, and
+``decomposition/rows.jsonl`` from the decomposition step) and writes ``out_dir/README.md`` with PNG
+figures and CSV tables beside it. Every number in the text is computed here from the stored rows.
+The sections of paper-opt (:mod:`sarcover.reports.optimum`), top-4-7
+(:mod:`sarcover.reports.top_sets`) and the decomposition (:mod:`sarcover.reports.decomposition`)
+live in their own modules and work on partial results.
 
 Coverage of a run = covered viewpoints / all viewpoints (M·K), as in the paper. A run without a
 plan (the method could not cover every target within E_max) counts as coverage 0 and is counted
@@ -22,12 +26,16 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from sarcover.reports.decomposition import write_decomposition  # noqa: E402
+from sarcover.reports.optimum import optimum_section  # noqa: E402
 from sarcover.reports.plots import save_figure  # noqa: E402
 from sarcover.reports.results import load_results  # noqa: E402
 from sarcover.reports.style import PAPER, PEERS, dodge, legend_outside, look  # noqa: E402
+from sarcover.reports.top_sets import top_sets_section  # noqa: E402
 
 ORDER = PAPER + PEERS  # the heuristics, in the order of every table and legend
 LONG_BP = "bp-300s"  # bp rows of the suite paper-gaps-long
+DECOMPOSITION = Path("decomposition") / "rows.jsonl"  # under the results root: the decomposition step's rows
 # Paper Table I (M = 20, N = 5, K = 3), seconds
 PAPER_TABLE1 = {"KMeans": 3.24, "DPC": 0.41, "ADPC": 1.03, "GA": 18.2, "ACO": 497.0, "PSO": 78.3}
 
@@ -116,6 +124,7 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
     pn, pk, peers = _load(root, "paper-n"), _load(root, "paper-k"), _load(root, "paper-peers")
     ex, pg, em = _load(root, "exact-small"), _load(root, "paper-gaps"), _load(root, "emax-sweep")
     t1, top = _load(root, "table1"), _load(root, "top-chao")
+    opt, top47 = _load(root, "paper-opt"), _load(root, "top-4-7")
     pg_long = _load(root, "paper-gaps-long")
     if pg is not None and pg_long is not None:  # bp at 300 s on some of the same instances
         pg = pd.concat([pg, pg_long.assign(method=LONG_BP)], ignore_index=True)
@@ -273,7 +282,12 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
               _projection(timing), "", "Table: `table1_runtime.csv`.", ""]
     # -- gaps
     L += _gaps_section(ex, pg, out)
+    if opt is not None:
+        L += optimum_section(opt, out)
+    L += _decomposition_section(root, out)
     L += _top_section(top, out)
+    if top47 is not None:
+        L += top_sets_section(top47, out)
     # -- E_max
     if em is not None:
         g = em.groupby(["method", "e_max"])
@@ -501,6 +515,19 @@ def _top_section(top: pd.DataFrame | None, out: Path) -> list[str]:
             + (" Files whose published value is only best known (not proven; see the PROVENANCE note), where "
                "a proof counts on its own: " + "; ".join(new) + "." if new else ""), "",
             _md(piv), "", "Table: `top_sets_exact.csv`.", ""]
+
+
+def _decomposition_section(root: Path, out: Path) -> list[str]:
+    """The gap decomposition (clustering / cross-cluster / routing loss) when its rows exist."""
+    rows = root / DECOMPOSITION
+    if not rows.is_file():
+        return []
+    text = write_decomposition(rows, out, heading="##")
+    head, _, rest = text.partition("\n")
+    intro = ("From the stored rows of the paper-opt suite (`python -m sarcover.benchmarks.reproduce`'s decomposition "
+             "step): OPT per instance is bp's proven optimum there, else its certified bound; where OPT is a bound "
+             "the gap and the clustering loss are upper bounds (the tables say where).")
+    return [head, "", intro, "", "![gap decomposition](decomposition.png)", "", rest.lstrip("\n"), ""]
 
 
 def _bp_run_summary(bp: pd.DataFrame) -> str:

@@ -451,8 +451,8 @@ def test_suite_with_jit_methods_compiles_before_the_workers_start(tmp_path):
 
 
 def test_own_folder_of_instance_files_gives_share_proven_and_certified_gaps(tmp_path):
-    """The README's recipe for TOP sets 4-7 (not shipped): a suite naming a folder of instance
-    files of its own (no published optima next to them). The report counts what bp proves per
+    """The README's recipe for instance files of one's own: a suite naming a folder of instance
+    files (no published optima next to them). The report counts what bp proves per
     size and bounds the gap of the runs it did not prove by their certified bound."""
     import shutil
 

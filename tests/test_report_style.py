@@ -9,7 +9,7 @@ import pytest
 
 from sarcover.benchmarks.harness import run_one
 from sarcover.benchmarks.registry import METHODS
-from sarcover.reports import reference, report
+from sarcover.reports import optimum, reference, report
 from sarcover.reports.style import GROUPS, look, ordered
 
 matplotlib.use("Agg")
@@ -96,12 +96,16 @@ def test_both_reports_draw_each_method_alike_with_legends_outside(results, tmp_p
     df["cov0"] = df["coverage"]
     heuristics = df[~df["exact"].astype(bool)]
     reference._sweep(heuristics, "K", tmp_path, "coverage_vs_K", "coverage against K", None)
+    opt_figures = _figures(monkeypatch, optimum)  # Fig. 3 with the optimum: every method, exact ones too
+    optimum.optimum_section(df, tmp_path)
 
-    names = {p.rsplit("/", 1)[-1] for p, _, _ in figures + ref_figures}
+    names = {p.rsplit("/", 1)[-1] for p, _, _ in figures + ref_figures + opt_figures}
     assert {"coverage_vs_K_M4_N2.png", "example_routes.png", "gap_distribution.png", "time_to_optimality.png",
-            "anytime.png", "coverage_vs_K.png"} <= names
+            "anytime.png", "coverage_vs_K.png", "paper_opt_vs_N.png"} <= names
+    [(_, _, opt_facts)] = opt_figures
+    assert set(opt_facts["entries"]) == set(METHODS)  # each method in the optimum figure's legend, in its look
     drawn = {}
-    for path, fig, facts in figures + ref_figures:
+    for path, fig, facts in figures + ref_figures + opt_figures:
         assert not any(facts["overlaps"]), f"{path}: a legend covers data"
         assert not (facts["suptitle"] and facts["titles"]), f"{path}: a title above panel titles"
         for m, (color, marker) in facts["entries"].items():
