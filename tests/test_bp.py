@@ -983,3 +983,43 @@ def test_root_out_of_time_right_after_the_route_pool_joined():
     proven, bound = bp.run()
     assert pool_added[-1] > 0  # the pool did add columns after the root LP
     assert not proven and bound >= OPTIMAL["p2.2.k"] - 1e-6
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("with_ng", [False, True])
+def test_enumeration_lists_every_route_above_the_threshold(seed, with_ng):
+    """Route enumeration (cut duals paid, with and without the backward ng suffix table) lists
+    one route per set of points for exactly the elementary routes whose best ordering's value
+    beats the threshold (brute force)."""
+    from sarcover.formulations.bp.enumeration import enumerate_routes
+    from sarcover.formulations.bp.master import _lm_coefficient
+    from sarcover.formulations.bp.pricing import nearest_ng
+
+    rng = np.random.default_rng(200 + seed)
+    cost, _, profit, budget = _tiny_pricing(seed)
+    n = cost.shape[0]
+    cuts, mems, members, memory, sig = _random_cuts(rng, n, 6)
+
+    def value(path):
+        pen = sum(s * _lm_coefficient(path, S, M) for S, M, s in zip(cuts, mems, sig))
+        return float(profit[list(path)].sum()) - pen
+
+    paths = [(value(p), p) for _, p in _brute_paths(cost, profit, budget)]
+    thr = 0.4 * max(v for v, _ in paths)
+    want = {frozenset(p) for v, p in paths if v > thr + 1e-9}
+    res = enumerate_routes(cost, profit, np.ones(n, dtype=bool), budget, thr,
+                           ng=nearest_ng(cost, 3) if with_ng else None, cut_members=members,
+                           cut_memory=memory, cut_duals=sig)
+    got = [frozenset(r) for r in res.routes]
+    assert len(got) == len(set(got))
+    assert set(got) == want
+    assert all(value(r) > thr for r in res.routes)
+
+
+def test_enumeration_keeps_the_published_optimum():
+    """With enumeration on (any window), bp still proves the published TOP optima."""
+    for name in ("p1.2.j", "p2.2.k", "p3.2.e", "p3.3.k"):
+        inst = load_instance(TOP_DIR / f"{name}.txt")
+        res = solve_bp(inst, time_limit=60, options=BPOptions(enum_share=0.5, enum_gap=1.0))
+        assert res.status == Status.OPTIMAL
+        assert verify(inst, res.plan).prize == pytest.approx(OPTIMAL[name])

@@ -70,6 +70,16 @@ class BPOptions:
     - ``elim_share``: time for the exact labelling arc bounds (30 s without a limit).
     - ``pool_routes``: best elementary routes of that labelling that join the master as columns
       (for the MILP over the generated routes).
+
+    Route enumeration (:mod:`.enumeration`):
+
+    - ``enum_share``: seconds for one try (listing the routes a better plan may use under the
+      root certificate, then the MILP over them), as a share of the limit (30 s without one);
+      0 (the default) turns enumeration off: on the M = 20, K = 4-6 instances the windows
+      left by the root are too wide for it (docs/bp.md).
+    - ``enum_gap``: only tried while the root certificate's bound is at most this many prize
+      steps above the incumbent + one step.
+    - ``enum_labels``, ``enum_routes``: a try gives up beyond this many labels or routes.
     """
 
     ng_size: int = 8
@@ -89,6 +99,10 @@ class BPOptions:
     strong: int = 5
     elim_share: float = 0.1
     pool_routes: int = 2000
+    enum_share: float = 0.0
+    enum_gap: float = 0.3
+    enum_labels: int = 4_000_000
+    enum_routes: int = 300_000
 
     @classmethod
     def for_time_limit(cls, time_limit: float | None) -> "BPOptions":

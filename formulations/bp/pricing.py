@@ -685,19 +685,22 @@ def _reversed(cost, profit, allowed):
 
 
 def _label_table(cost, profit, budget, ng, allowed, threshold, max_labels, deadline, delta, nb,
-                 n_routes=0):
+                 n_routes=0, cuts=None):
     """``t[v, b]``: the best prize of a label at v of energy <= b units, over the labels of a
     one-way exact ng-labelling with the fixed ``threshold``, and up to ``n_routes`` elementary
-    routes above the threshold (best first, one per set of points); None if it hit a cap."""
+    routes above the threshold (best first, one per set of points); None if it hit a cap.
+    ``cuts``: (cut members, cut memory, byte sums of the duals) as :func:`_label` takes them;
+    None: no cuts."""
     n = cost.shape[0]
     end = n - 1
     ret = cheapest_return(cost)
     order, cin, reach, lastord, cend = _prepare(cost, ret, profit, allowed)
+    if cuts is None:
+        cuts = (np.zeros(n, np.uint64), np.zeros(n, np.uint64), np.zeros((8, 256)))
     count, node, pred, en, pr, _, _, hit, _ = _label(
         cost, ret, profit, budget, ng, allowed, False, max_labels, order, cin, reach, lastord,
-        cend, float(threshold), float(deadline), float(budget), np.zeros(n, np.uint64),
-        np.zeros(n, np.uint64), np.zeros((8, 256)), *suffix_tables(cost, profit, allowed, budget),
-        True,
+        cend, float(threshold), float(deadline), float(budget), *cuts,
+        *suffix_tables(cost, profit, allowed, budget), True,
     )
     if hit:
         return None
@@ -888,4 +891,7 @@ def warm_up() -> None:
                   max_labels=100, n_cols=1, min_gain=0.5, bidirectional=bi)
     arc_bounds(cost, prof, allowed, 4.0)  # the arc elimination's bounds
     label_arc_bounds(cost, prof, allowed, 4.0, full_ng(3), -1.0, n_routes=1)
+    from sarcover.formulations.bp.enumeration import warm_up as enumeration_warm_up
+
+    enumeration_warm_up()  # the route enumeration's kernel
     _WARM = True

@@ -33,6 +33,12 @@ class Stats:
     elim_s: float = 0.0  # time spent on their bounds
     elim_labels: bool | None = None  # the labelling bound ran to the end (None: not tried)
     pool_routes: int = 0  # routes its search added to the master
+    enum_tries: int = 0  # route enumerations tried (closing the root gap)
+    enum_labels: int | None = None  # labels and routes of the last one (routes None: capped)
+    enum_routes: int | None = None
+    enum_s: float = 0.0
+    enum_milp_s: float = 0.0  # the MILP over the enumerated routes
+    enum_status: str | None = None  # its outcome: optimal, infeasible (proof) or open
     root_lp: float | None = None  # restricted root LP value when cuts were first considered
     pricing_s: float = 0.0
     lp_s: float = 0.0
@@ -55,6 +61,9 @@ class Stats:
             "cuts": self.cuts, "cuts_purged": self.cuts_purged,
             "arcs_eliminated": self.arcs_eliminated, "elim_s": round(self.elim_s, 3),
             "elim_labels": self.elim_labels, "pool_routes": self.pool_routes,
+            "enum_tries": self.enum_tries, "enum_labels": self.enum_labels,
+            "enum_routes": self.enum_routes, "enum_s": round(self.enum_s, 3),
+            "enum_milp_s": round(self.enum_milp_s, 3), "enum_status": self.enum_status,
             "root_lp": self.root_lp, "primal_s": self.primal_s, "primal_prize": self.primal_prize,
             "primal_improved": self.primal_improved, "primal_error": self.primal_error,
             "pricing_s": round(self.pricing_s, 3), "lp_s": round(self.lp_s, 3),

@@ -22,6 +22,7 @@ from sarcover.formulations.bp.branching import branch
 from sarcover.formulations.bp.colgen import ColumnGeneration
 from sarcover.formulations.bp.cuts import CutRounds
 from sarcover.formulations.bp.elimination import Elimination
+from sarcover.formulations.bp.enumeration import Enumeration
 from sarcover.formulations.bp.incumbent import IncumbentSearch
 from sarcover.formulations.bp.node import NodeState
 from sarcover.formulations.bp.options import BPOptions
@@ -57,6 +58,10 @@ class BranchAndPrice:
         self.cuts = CutRounds(s, self.elimination, rounds=opts.cut_rounds,
                               per_round=opts.cuts_per_round, gap=opts.cut_gap,
                               until=s.until(opts.cut_share))
+        self.enumeration = (Enumeration(s, self.elimination, self.incumbents,
+                                        limit=share(opts.enum_share), gap=opts.enum_gap,
+                                        max_labels=opts.enum_labels, max_routes=opts.enum_routes)
+                            if opts.enum_share > 0 else None)
         self.colgen = ColumnGeneration(s, self.pricer, self.elimination, self.incumbents,
                                        self.cuts, ng_cap=opts.ng_cap,
                                        grow_until=s.until(opts.grow_share))
@@ -117,6 +122,8 @@ class BranchAndPrice:
         while heap:
             if s.time_left() <= 0:
                 break
+            if s.stats.nodes and self.enumeration is not None and self.enumeration.close():
+                return self._close([], [], True)  # every better plan was among its routes
             _, _, negb, _, state = heapq.heappop(heap)
             parent_bound = -negb
             if s.prunable(parent_bound):

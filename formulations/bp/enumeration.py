@@ -1,0 +1,425 @@
+"""Route enumeration once the root gap is small, and the set-packing MILP over the enumerated
+routes that closes it (Baldacci, Christofides & Mingozzi 2008; Pecin et al. 2017).
+
+Under the duals y that certified the root bound (:class:`.elimination.Certificate`), a plan
+better than the incumbent only uses elementary routes of reduced prize >= the certificate's floor
+(:meth:`.elimination.Elimination.rc_floor`). When few routes reach it, all of them can be listed:
+a labelling from the start over elementary paths (full visited sets), where a label is only
+dominated by a label at the same point with the *same* visited set (no less prize after the cuts'
+duals, no more energy), and pruned by the pricing's completion and suffix bounds against the
+fixed floor, on the graph the arc elimination leaves. Each visited set is one column of the
+master (its rows only see the set), so one route per set is enough.
+
+The MILP over them (vehicles <= N, each point at most once, each group covered; the subset-row
+cuts are valid inequalities and left out) with the row "prize >= incumbent + step" then decides
+the run: a solution is an optimal plan (every better plan is among its columns), infeasibility
+proves the incumbent optimal. Both only hold when the enumeration and the MILP finished; a cap
+or a time limit leaves the run as it was.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING, NamedTuple
+
+import highspy
+import numpy as np
+from numba import njit, objmode
+
+from sarcover.formulations.bp.master import INF, _lm_coefficient, quiet_highs
+from sarcover.formulations.bp.node import NodeState, node_graph
+from sarcover.formulations.bp.pricing import (
+    DP_UNITS, EPS, _byte_sums, _completion, _dp_bound, _dp_unit, _grow, _heap_pop, _heap_push,
+    _label_table, _prepare, _reversed, _sigsum, cheapest_return, suffix_tables)
+
+if TYPE_CHECKING:
+    from sarcover.formulations.bp.elimination import Elimination
+    from sarcover.formulations.bp.incumbent import IncumbentSearch
+    from sarcover.formulations.bp.search import Search
+
+
+@njit(cache=True)
+def _key_hash(w, mask):
+    """Hash of (point, visited set) for the open-addressing table (splitmix64 steps)."""
+    h = np.uint64(w) * np.uint64(0x9E3779B97F4A7C15)
+    for k in range(mask.shape[0]):
+        h ^= mask[k] + np.uint64(0x9E3779B97F4A7C15) + (h << np.uint64(6)) + (h >> np.uint64(2))
+        h ^= h >> np.uint64(30)
+        h *= np.uint64(0xBF58476D1CE4E5B9)
+        h ^= h >> np.uint64(27)
+    return h
+
+
+@njit(cache=True)
+def _enumerate(cost, ret, profit, budget, allowed, order, cin, reach, lastord, cend, threshold,
+               max_labels, deadline, cmem, mmem, sig, g1, s1, g2, delta, nb, sfx, sdelta, snb):
+    """Labels of every elementary path start -> ... whose prize (after the cuts' duals) plus
+    the completion and suffix bounds exceeds ``threshold``; a label is dropped only when a label
+    at the same point with the same visited set has no more energy and no less prize (after
+    paying the duals of the cuts where it holds an odd visit and the new one does not).
+    ``sfx[w, b]`` (``snb`` > 0): the most prize of a suffix w -> ... -> end of energy <= b units
+    of ``sdelta`` (w's own prize counted, the cuts' duals paid) over every suffix of a path
+    above the threshold, a third bound.
+
+    Labels with equal (point, set) form a list (``nxt``) whose head sits in an open-addressing
+    table. Returns (count, node, pred, energy, prize, mask, alive, hit_cap)."""
+    n = cost.shape[0]
+    W = (n + 63) // 64
+    cap = 1024
+    node = np.empty(cap, np.int32)
+    pred = np.empty(cap, np.int32)
+    en = np.empty(cap, np.float64)
+    pr = np.empty(cap, np.float64)
+    alive = np.empty(cap, np.bool_)
+    mask = np.zeros((cap, W), np.uint64)
+    srb = np.zeros(cap, np.uint64)
+    nxt = np.empty(cap, np.int32)
+    tsize = 1 << 12
+    table = np.full(tsize, -1, np.int32)
+    used = 0
+    node[0] = 0
+    pred[0] = -1
+    en[0] = 0.0
+    pr[0] = 0.0
+    alive[0] = True
+    nxt[0] = -1
+    count = 1
+    hit = False
+    hkey = np.empty(cap, np.float64)
+    hval = np.empty(cap, np.int32)
+    hkey[0] = 0.0
+    hval[0] = 0
+    hn = 1
+    newmask = np.zeros(W, np.uint64)
+    end = n - 1
+    while hn > 0:
+        qi = hval[0]
+        hn = _heap_pop(hkey, hval, hn)
+        if not alive[qi]:
+            continue
+        v = node[qi]
+        for w in range(1, end):
+            if not allowed[w]:
+                continue
+            e2 = en[qi] + cost[v, w]
+            if not (e2 + ret[w] <= budget):  # also rejects inf (removed arcs)
+                continue
+            wd = w >> 6
+            wb = np.uint64(1) << np.uint64(w & 63)
+            if mask[qi, wd] & wb:
+                continue
+            p2 = pr[qi] + profit[w]
+            sq = srb[qi] & mmem[w]
+            hitc = sq & cmem[w]
+            if hitc:
+                p2 -= _sigsum(hitc, sig)
+            s2 = sq ^ cmem[w]
+            for k in range(W):
+                newmask[k] = mask[qi, k]
+            newmask[wd] |= wb
+            if p2 + _dp_bound(g1, s1, g2, w, v, budget - e2, delta, nb) <= threshold:
+                continue
+            if snb > 0:
+                # the path splits at the arc v -> w: pairs of a cut across the split only
+                # lower the route's prize further
+                b = min(int((budget - e2) / sdelta + 2e-9), snb)
+                if pr[qi] + sfx[w, b] <= threshold:
+                    continue
+            if p2 + _completion(newmask, w, budget - e2, threshold - p2, order, profit, cin, reach,
+                                lastord, cend) <= threshold:
+                continue
+            # the labels of the same point and set: find the list's slot
+            slot = np.int64(_key_hash(w, newmask) & np.uint64(tsize - 1))
+            while table[slot] >= 0:
+                j = table[slot]
+                same = node[j] == w
+                if same:
+                    for k in range(W):
+                        if mask[j, k] != newmask[k]:
+                            same = False
+                            break
+                if same:
+                    break
+                slot = (slot + 1) & (tsize - 1)
+            head = table[slot]
+            dominated = False
+            j = head
+            while j >= 0:
+                if alive[j]:
+                    if en[j] <= e2 + EPS and pr[j] - _sigsum(srb[j] & ~s2, sig) >= p2 - EPS:
+                        dominated = True
+                        break
+                    if e2 <= en[j] + EPS and p2 - _sigsum(s2 & ~srb[j], sig) >= pr[j] - EPS:
+                        alive[j] = False  # never extended: it has more energy than the new one
+                j = nxt[j]
+            if dominated:
+                continue
+            if count == max_labels:
+                hit = True
+                break
+            if (count & 4095) == 0:
+                with objmode(now="float64"):
+                    now = time.perf_counter()
+                if now > deadline:
+                    hit = True
+                    break
+            if count == cap:
+                cap *= 2
+                node = _grow(node, cap)
+                pred = _grow(pred, cap)
+                en = _grow(en, cap)
+                pr = _grow(pr, cap)
+                alive = _grow(alive, cap)
+                mask = _grow(mask, cap)
+                srb = _grow(srb, cap)
+                nxt = _grow(nxt, cap)
+                hkey = _grow(hkey, cap)
+                hval = _grow(hval, cap)
+            node[count] = w
+            pred[count] = qi
+            en[count] = e2
+            pr[count] = p2
+            alive[count] = True
+            srb[count] = s2
+            for k in range(W):
+                mask[count, k] = newmask[k]
+            nxt[count] = head
+            table[slot] = count
+            if head < 0:
+                used += 1
+                if 2 * used > tsize:  # keep the table at most half full
+                    tsize *= 2
+                    new = np.full(tsize, -1, np.int32)
+                    for s0 in range(tsize // 2):
+                        h0 = table[s0]
+                        if h0 < 0:
+                            continue
+                        t0 = np.int64(_key_hash(node[h0], mask[h0]) & np.uint64(tsize - 1))
+                        while new[t0] >= 0:
+                            t0 = (t0 + 1) & (tsize - 1)
+                        new[t0] = h0
+                    table = new
+            hn = _heap_push(hkey, hval, hn, e2, count)
+            count += 1
+        if hit:
+            break
+    return (count, node[:count], pred[:count], en[:count], pr[:count], mask[:count],
+            alive[:count], hit)
+
+
+class Enumerated(NamedTuple):
+    """Outcome of :func:`enumerate_routes`: the routes (one per visited set, solver points
+    without start and end; None when a cap or the deadline stopped the search) and the labels
+    made."""
+
+    routes: list | None
+    n_labels: int
+
+
+def enumerate_routes(cost, profit, allowed, budget, threshold, *, ng=None, cut_members=None,
+                     cut_memory=None, cut_duals=None, max_labels=5_000_000,
+                     max_routes=300_000, deadline=np.inf) -> Enumerated:
+    """Every elementary route start -> ... -> end of energy <= ``budget`` whose prize (sum of
+    ``profit`` over its points, the cuts' duals paid as in the pricing) exceeds ``threshold``,
+    one per set of points. ``cost`` has removed arcs at inf; ``allowed``: the points a route may
+    visit. None (in ``routes``) when more than ``max_labels`` labels or ``max_routes`` routes
+    would be needed, or at the ``deadline``.
+
+    With ``ng`` (ng sets) a backward exact ng-labelling over the whole budget first tabulates
+    the best suffix from each point by energy (:func:`.pricing._label_table`, the cuts' duals
+    paid): every suffix of a path above the threshold is dominated by one of its labels, so a
+    path whose prefix's prize plus the suffix bound of its next point does not exceed the
+    threshold has no route to list (a cut's pairs along a route are at least those of its
+    prefix plus those of its suffix, so splitting never undercounts the duals). Much tighter
+    than the knapsack and DP bounds alone."""
+    n = cost.shape[0]
+    cost = np.ascontiguousarray(cost, dtype=np.float64)
+    profit = np.ascontiguousarray(profit, dtype=np.float64)
+    if cut_members is None or cut_duals is None or not np.any(np.asarray(cut_duals) > 0):
+        cmem = np.zeros(n, np.uint64)
+        mmem = np.zeros(n, np.uint64)
+        sig = np.zeros((8, 256))
+    else:
+        duals = np.asarray(cut_duals, dtype=np.float64)
+        active = np.uint64(0)
+        for c in np.flatnonzero(duals > 0):
+            active |= np.uint64(1) << np.uint64(c)
+        cmem = np.ascontiguousarray(np.asarray(cut_members, dtype=np.uint64) & active)
+        mmem = (np.full(n, np.uint64(0xFFFFFFFFFFFFFFFF), dtype=np.uint64) if cut_memory is None
+                else np.ascontiguousarray(cut_memory, dtype=np.uint64))
+        sig = _byte_sums(np.where(duals > 0, duals, 0.0))
+    sfx, sdelta, snb = np.zeros((n, 1)), 1.0, 0
+    if ng is not None:
+        delta, nb = _dp_unit(cost, budget, DP_UNITS)
+        if nb > 0:
+            perm, cost_b, profit_b, allowed_b = _reversed(cost, profit, allowed)
+            bwd = _label_table(cost_b, profit_b, budget, ng, allowed_b, threshold, max_labels,
+                               deadline, delta, nb, cuts=(cmem[perm], mmem[perm], sig))
+            if bwd is None:
+                return Enumerated(None, max_labels)
+            sfx, sdelta, snb = np.ascontiguousarray(bwd[0][perm]), delta, nb
+    ret = cheapest_return(cost)
+    order, cin, reach, lastord, cend = _prepare(cost, ret, profit, allowed)
+    count, node, pred, en, pr, mask, _, hit = _enumerate(
+        cost, ret, profit, float(budget), allowed, order, cin, reach, lastord, cend,
+        float(threshold), int(max_labels), float(deadline), cmem, mmem, sig,
+        *suffix_tables(cost, profit, allowed, budget), sfx, float(sdelta), int(snb))
+    if hit:
+        return Enumerated(None, int(count))
+    end = n - 1
+    done = np.flatnonzero((node > 0) & (en + cost[node, end] <= budget) & (pr > threshold))
+    # one label per visited set (the cheapest; any would do for the master's column)
+    done = done[np.argsort(en[done], kind="stable")]
+    _, first = np.unique(mask[done], axis=0, return_index=True)
+    done = done[np.sort(first)]
+    if done.size > max_routes:
+        return Enumerated(None, int(count))
+    # the paths, all at once: walk the predecessors back level by level
+    paths = [[] for _ in range(done.size)]
+    cur = done.copy()
+    live = np.arange(done.size)
+    while live.size:
+        for i, p in zip(live.tolist(), node[cur].tolist()):
+            paths[i].append(p)
+        cur = pred[cur]
+        keep = cur > 0
+        live, cur = live[keep], cur[keep]
+    return Enumerated([tuple(reversed(p)) for p in paths], int(count))
+
+
+def packing_milp(master, routes, need: float, time_limit: float, *, cuts=(), need_row=True):
+    """The best plan over ``routes`` (set packing with the master's root rows: vehicles, each
+    point at most once, each group covered) among those worth at least ``need``. Returns
+    (status, routes): ("optimal", plan), ("infeasible", None): no such plan, or ("open", plan or
+    None) at the time limit. ``cuts``: (triple, memory) pairs of subset-row cuts, added as rows
+    (valid for every plan; they tighten the MILP's LP)."""
+    k = len(routes)
+    if k == 0:
+        return "infeasible", None
+    m = master
+    starts = np.zeros(k + 1, np.int64)
+    idx, val, prize = [], [], np.zeros(k)
+    rows_extra = m.n_rows  # the prize row after the root rows
+    for r, pts in enumerate(routes):
+        rows = {0: 1.0}
+        for p in pts:
+            rows[p] = 1.0
+            g = m.group_of_point[p]
+            if g >= 0:
+                row = 1 + m.V + g
+                rows[row] = rows.get(row, 0.0) + 1.0
+        pz = float(m.prizes[np.asarray(pts, dtype=np.int64) - 1].sum())
+        prize[r] = pz
+        rows[rows_extra] = pz
+        for c, (S, M) in enumerate(cuts):
+            a = _lm_coefficient(pts, S, M)
+            if a:
+                rows[rows_extra + 1 + c] = float(a)
+        for i in sorted(rows):
+            idx.append(i)
+            val.append(rows[i])
+        starts[r + 1] = len(idx)
+    h = quiet_highs()
+    h.setOptionValue("time_limit", max(0.05, float(time_limit)))
+    h.setOptionValue("mip_rel_gap", 0.0)
+    h.setOptionValue("mip_abs_gap", 0.0)
+    h.changeObjectiveSense(highspy.ObjSense.kMaximize)
+    lo = np.concatenate([m.row_lo, [need if need_row else -INF], np.full(len(cuts), -INF)])
+    hi = np.concatenate([m.row_hi, [INF], np.ones(len(cuts))])
+    h.addRows(lo.size, lo, hi, 0, np.zeros(lo.size, np.int32), np.zeros(0, np.int32),
+              np.zeros(0))
+    h.addCols(k, prize, np.zeros(k), np.ones(k), int(starts[-1]), starts[:-1].astype(np.int32),
+              np.asarray(idx, np.int32), np.asarray(val))
+    h.changeColsIntegrality(k, np.arange(k, dtype=np.int32),
+                            np.full(k, highspy.HighsVarType.kInteger))
+    h.run()
+    st = h.getModelStatus()
+    if st == highspy.HighsModelStatus.kInfeasible:
+        return "infeasible", None
+    plan = None
+    if h.getInfo().primal_solution_status == 2:  # kSolutionStatusFeasible
+        x = np.asarray(h.getSolution().col_value)
+        plan = [routes[r] for r in np.flatnonzero(x > 0.5)]
+    return ("optimal" if st == highspy.HighsModelStatus.kOptimal else "open"), plan
+
+
+def warm_up() -> None:
+    """Compile (or load from numba's cache) the enumeration kernel on a tiny graph."""
+    cost = np.array([[0.0, 1.0, 2.0], [1.0, 0.0, 1.0], [2.0, 1.0, 0.0]])
+    enumerate_routes(cost, np.array([0.0, 1.0, 0.0]), np.ones(3, dtype=bool), 4.0, -1.0)
+
+
+class Enumeration:
+    """Closing the root gap by enumeration: :meth:`close` lists the routes that a plan better
+    than the incumbent may use under the root certificate and solves the MILP over them. It is
+    tried once the root LP is solved, and again whenever the incumbent has improved since the
+    last try (the floor rises, fewer routes reach it). ``limit``: seconds per try (labelling and
+    MILP); ``gap``: the largest window tried (see :meth:`due`); ``max_labels``, ``max_routes``:
+    the caps beyond which a try gives up."""
+
+    def __init__(self, search: "Search", elimination: "Elimination",
+                 incumbents: "IncumbentSearch", *, limit: float, gap: float, max_labels: int,
+                 max_routes: int):
+        self.search = search
+        self.elimination = elimination
+        self.incumbents = incumbents
+        self.limit = limit
+        self.gap = gap
+        self.max_labels = max_labels
+        self.max_routes = max_routes
+        self._tried = None  # (certificate, incumbent value) of the last try
+
+    def due(self) -> bool:
+        """A try could now succeed where the last one did not: a certificate and an incumbent
+        exist, one of them changed since the last try, and the certificate's bound is at most
+        ``gap`` prize steps above the incumbent + one step (the number of routes to list grows
+        steeply with that window)."""
+        s, elim = self.search, self.elimination
+        if elim.rc_floor() is None or s.time_left() <= 0:
+            return False
+        window = elim.cert.bound - s.incumbent_value - s.step
+        if window > self.gap * s.step:
+            return False
+        return self._tried != (elim.cert, s.incumbent_value)
+
+    def close(self) -> bool:
+        """One try; True when it proved the incumbent (possibly a new one, the MILP's) optimal.
+        """
+        s, elim, m = self.search, self.elimination, self.search.master
+        if not self.due():
+            return False
+        cert = elim.cert
+        self._tried = (cert, s.incumbent_value)
+        floor = elim.rc_floor()
+        t = time.perf_counter()
+        deadline = min(s.deadline, t + self.limit)
+        y = cert.duals
+        cost, _, allowed = node_graph(s, NodeState())
+        sig = np.zeros(len(m.cuts))
+        cut = np.maximum(y[m.base_rows :], 0.0)[: len(m.cuts)]
+        sig[: cut.size] = cut
+        res = enumerate_routes(cost, m.point_profit(y), allowed, s.budget, y[0] + floor,
+                               ng=s.ng, cut_members=m.cut_members, cut_memory=m.cut_memory,
+                               cut_duals=sig, max_labels=self.max_labels,
+                               max_routes=self.max_routes, deadline=deadline)
+        st = s.stats
+        st.enum_tries += 1
+        st.enum_labels = res.n_labels
+        st.enum_routes = None if res.routes is None else len(res.routes)
+        st.enum_s += time.perf_counter() - t
+        if res.routes is None:
+            return False
+        t = time.perf_counter()
+        need = s.incumbent_value + (s.step if s.integral else 1e-9)
+        cuts = [(frozenset(S), M) for S, M in zip(m.cuts, m.memories)]
+        status, plan = packing_milp(m, res.routes, need, deadline - t, cuts=cuts)
+        st.enum_milp_s += time.perf_counter() - t
+        st.enum_status = status
+        if plan is not None:
+            self.incumbents.offer(plan)
+        if status == "infeasible":
+            return True
+        if status == "optimal" and plan is not None:
+            value = float(np.sum([m.prizes[np.asarray(r) - 1].sum() for r in plan]))
+            return s.incumbent_value >= value - 1e-6
+        return False
