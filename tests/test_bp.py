@@ -686,24 +686,32 @@ def _random_cuts(rng, n, n_cuts):
     return cuts, mems, members, memory, rng.uniform(0.05, 0.8, n_cuts)
 
 
-@pytest.mark.parametrize("seed", range(8))
-def test_exact_pricing_with_cuts_matches_enumeration(seed):
-    """With subset-row cut duals, exact elementary labelling finds the best path's prize minus
-    the duals of the cuts it pays (limited-memory coefficients, enumerated); every route it
-    returns has the value it claims to beat; ng labelling stays an upper bound."""
+def _cut_priced(seed: int, cut_seed: int):
+    """A tiny pricing problem with six random subset-row cuts: (cost, ret, profit, budget,
+    (cut members, cut memory, cut duals), value of a path with its cut duals paid, every
+    elementary path as (value, path) by brute force)."""
     from sarcover.formulations.bp.master import _lm_coefficient
-    from sarcover.formulations.bp.pricing import full_ng, nearest_ng, price
 
-    rng = np.random.default_rng(100 + seed)
     cost, ret, profit, budget = _tiny_pricing(seed)
-    n = cost.shape[0]
-    cuts, mems, members, memory, sig = _random_cuts(rng, n, 6)
+    cuts, mems, members, memory, sig = _random_cuts(np.random.default_rng(cut_seed), cost.shape[0], 6)
 
     def value(path):
         pen = sum(s * _lm_coefficient(path, S, M) for S, M, s in zip(cuts, mems, sig))
         return float(profit[list(path)].sum()) - pen
 
     paths = [(value(p), p) for _, p in _brute_paths(cost, profit, budget)]
+    return cost, ret, profit, budget, (members, memory, sig), value, paths
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_exact_pricing_with_cuts_matches_enumeration(seed):
+    """With subset-row cut duals, exact elementary labelling finds the best path's prize minus
+    the duals of the cuts it pays (limited-memory coefficients, enumerated); every route it
+    returns has the value it claims to beat; ng labelling stays an upper bound."""
+    from sarcover.formulations.bp.pricing import full_ng, nearest_ng, price
+
+    cost, ret, profit, budget, (members, memory, sig), value, paths = _cut_priced(seed, 100 + seed)
+    n = cost.shape[0]
     best = max(v for v, _ in paths)
     gain = 0.2 * best
     kw = dict(max_labels=1_000_000, n_cols=50, min_gain=gain, cut_members=members,
@@ -992,19 +1000,10 @@ def test_enumeration_lists_every_route_above_the_threshold(seed, with_ng):
     one route per set of points for exactly the elementary routes whose best ordering's value
     beats the threshold (brute force)."""
     from sarcover.formulations.bp.enumeration import enumerate_routes
-    from sarcover.formulations.bp.master import _lm_coefficient
     from sarcover.formulations.bp.pricing import nearest_ng
 
-    rng = np.random.default_rng(200 + seed)
-    cost, _, profit, budget = _tiny_pricing(seed)
+    cost, _, profit, budget, (members, memory, sig), value, paths = _cut_priced(seed, 200 + seed)
     n = cost.shape[0]
-    cuts, mems, members, memory, sig = _random_cuts(rng, n, 6)
-
-    def value(path):
-        pen = sum(s * _lm_coefficient(path, S, M) for S, M, s in zip(cuts, mems, sig))
-        return float(profit[list(path)].sum()) - pen
-
-    paths = [(value(p), p) for _, p in _brute_paths(cost, profit, budget)]
     thr = 0.4 * max(v for v, _ in paths)
     want = {frozenset(p) for v, p in paths if v > thr + 1e-9}
     res = enumerate_routes(cost, profit, np.ones(n, dtype=bool), budget, thr,
