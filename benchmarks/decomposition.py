@@ -274,18 +274,22 @@ def row_key(row: dict) -> str:
 
 
 def decompose(source, out_path: str | Path, *, methods=tuple(METHODS), seeds=(0,), time_limit: float = 60.0,
-              clustered_time_limit: float | None = 120.0, unvisited: str = "assign",
+              clustered_time_limit: float | None = 120.0, unvisited: str = "assign", workers: int = 1,
               stream=sys.stderr) -> list[dict]:
     """Decompose every (case, method, seed) into ``out_path`` (JSON lines), resumably.
 
     ``source``: a results directory (:func:`cases_from_results`) or a list of :class:`Case`.
     A row whose key (instance|method|seed) is already in the file is skipped; each new row is
-    appended and flushed when it is done, so a killed run loses at most the row in flight.
-    OPT|C solves already stored (same instance and clustering) are reused. ``time_limit`` is the
-    methods' (a safety net for the pipelines), ``clustered_time_limit`` each OPT|C solve's.
-    Returns all rows of the file.
+    appended and flushed when it is done, so a killed run loses at most the rows in flight (one
+    per worker). OPT|C solves already stored (same instance and clustering) are reused.
+    ``time_limit`` is the methods' (a safety net for the pipelines), ``clustered_time_limit`` each
+    OPT|C solve's. ``workers`` > 1 decomposes that many instances at a time in forked processes
+    (one thread each; an instance's rows stay in one process, so its methods share their OPT|C
+    solves); rows are then appended in the order they finish. Returns all rows of the file.
     """
     cases = cases_from_results(source) if isinstance(source, (str, Path)) else list(source)
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
     out_path = Path(out_path)
     out_path.parent.mkdir(parents=True, exist_ok=True)
     done = read_decomposition(out_path)
@@ -296,17 +300,84 @@ def decompose(source, out_path: str | Path, *, methods=tuple(METHODS), seeds=(0,
             cache.remember(r["instance"], r["clusters"], _entry_from_row(r, "opt_c"))
         if r.get("clusters_plan") is not None and r.get("opt_cp_status") is not None:
             cache.remember(r["instance"], r["clusters_plan"], _entry_from_row(r, "opt_cp"))
-    jobs = [(c, m, s) for c in cases for m in methods for s in seeds if f"{c.name}|{m}|{s}" not in have]
+    todo = [(c, [(m, s) for m in methods for s in seeds if f"{c.name}|{m}|{s}" not in have]) for c in cases]
+    todo = [(c, jobs) for c, jobs in todo if jobs]
+    total = sum(len(jobs) for _, jobs in todo)
+    _end_torn_line(out_path)
     t0 = time.perf_counter()
+    count = 0
     with out_path.open("a") as fh:
-        for n, (case, method, seed) in enumerate(jobs, 1):
-            row = decompose_one(case, method, seed=seed, cache=cache, time_limit=time_limit, unvisited=unvisited)
+        def store(row: dict) -> None:
+            nonlocal count
             fh.write(json.dumps(row) + "\n")
             fh.flush()
             done.append(row)
+            count += 1
             if stream is not None:
-                print(f"decompose: {n}/{len(jobs)} {row_key(row)}: gap {row.get('gap')} = clustering "
+                print(f"decompose: {count}/{total} {row_key(row)}: gap {row.get('gap')} = clustering "
                       f"{row.get('clustering_loss')} + cross {row.get('cross_cluster')} + routing "
                       f"{row.get('routing_loss')} (OPT|C {row.get('opt_c')} in {row.get('opt_c_s')} s; "
                       f"{time.perf_counter() - t0:.0f} s so far)", file=stream, flush=True)
+
+        if workers == 1 or len(todo) <= 1:
+            for case, jobs in todo:
+                for method, seed in jobs:
+                    store(decompose_one(case, method, seed=seed, cache=cache, time_limit=time_limit,
+                                        unvisited=unvisited))
+        else:
+            _decompose_parallel(todo, cache, time_limit, unvisited, workers, store)
     return done
+
+
+def _end_torn_line(path: Path) -> None:
+    """End a half-written last line (a killed run's) so the next row starts on a line of its own."""
+    if path.is_file() and path.stat().st_size:
+        with path.open("rb") as fh:
+            fh.seek(-1, 2)
+            if fh.read(1) != b"\n":
+                with path.open("a") as out:
+                    out.write("\n")
+
+
+_QUEUE = None  # the forked workers' channel back to the parent (set before the fork)
+
+
+def _decompose_case(case: Case, jobs, cache: ClusteredCache, time_limit: float, unvisited: str) -> int:
+    for method, seed in jobs:
+        _QUEUE.put(decompose_one(case, method, seed=seed, cache=cache, time_limit=time_limit, unvisited=unvisited))
+    return len(jobs)
+
+
+def _decompose_parallel(todo, cache: ClusteredCache, time_limit: float, unvisited: str, workers: int, store) -> None:
+    """One task per instance in a pool of forked processes; each row travels back on a queue as
+    it ends and ``store`` writes it, so the file grows row by row as in the serial loop."""
+    import multiprocessing as mp
+    import queue
+
+    global _QUEUE
+    ctx = mp.get_context("fork")
+    _QUEUE = ctx.Queue()
+    try:
+        with ctx.Pool(min(workers, len(todo))) as pool:
+            tasks = []
+            for case, jobs in todo:
+                own = ClusteredCache(cache.time_limit)  # this instance's stored OPT|C solves only
+                own.store = {k: v for k, v in cache.store.items() if k[0] == case.name}
+                tasks.append(pool.apply_async(_decompose_case, (case, jobs, own, time_limit, unvisited)))
+            while True:
+                try:
+                    store(_QUEUE.get(timeout=0.5))
+                    continue
+                except queue.Empty:
+                    pass
+                for t in tasks:
+                    if t.ready():
+                        t.get()  # re-raises a worker's exception here
+                if all(t.ready() for t in tasks):
+                    while True:  # rows put just before the last task ended
+                        try:
+                            store(_QUEUE.get(timeout=0.5))
+                        except queue.Empty:
+                            return
+    finally:
+        _QUEUE = None

@@ -34,6 +34,7 @@ the report. Every step resumes: a stopped run continues where it stopped. The re
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -48,9 +49,10 @@ DECOMPOSE_SETTINGS = [(3, 2), (3, 3), (3, 4), (3, 5), (3, 6), (6, 5)]
 STEPS = SUITES[:SUITES.index(DECOMPOSE_FROM) + 1] + [DECOMPOSITION] + SUITES[SUITES.index(DECOMPOSE_FROM) + 1:]
 
 
-def decompose_step(root: Path, *, quiet: bool = False) -> int:
+def decompose_step(root: Path, *, quiet: bool = False, workers: int | None = None) -> int:
     """Decompose the paper methods' gaps on paper-opt's instances of DECOMPOSE_SETTINGS into
-    ``root/decomposition/rows.jsonl`` (resumable: stored rows are skipped); returns the rows there."""
+    ``root/decomposition/rows.jsonl`` (resumable: stored rows are skipped), ``workers`` instances
+    at a time (default: all cores); returns the rows there."""
     from sarcover.benchmarks.decomposition import cases_from_results, decompose
 
     source = root / DECOMPOSE_FROM
@@ -58,7 +60,8 @@ def decompose_step(root: Path, *, quiet: bool = False) -> int:
         print(f"{DECOMPOSITION}: no {DECOMPOSE_FROM} results in {source}; skipped", file=sys.stderr)
         return 0
     cases = [c for c in cases_from_results(source) if (c.meta.get("K"), c.meta.get("N")) in DECOMPOSE_SETTINGS]
-    rows = decompose(cases, root / DECOMPOSITION / "rows.jsonl", stream=None if quiet else sys.stderr)
+    rows = decompose(cases, root / DECOMPOSITION / "rows.jsonl", workers=workers or os.cpu_count() or 1,
+                     stream=None if quiet else sys.stderr)
     return len(rows)
 
 
@@ -86,7 +89,7 @@ def main(argv: list[str] | None = None) -> int:
                 continue
             if name == DECOMPOSITION:
                 t0 = time.monotonic()
-                n = decompose_step(root, quiet=args.quiet)
+                n = decompose_step(root, quiet=args.quiet, workers=args.workers)
                 print(f"{name}: {n} rows in {time.monotonic() - t0:.0f} s", file=sys.stderr)
                 continue
             runs = args.runs if name in ("paper-n", "paper-k") else None

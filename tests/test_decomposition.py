@@ -123,6 +123,23 @@ def test_resume_skips_stored_rows_and_survives_a_torn_line(small_rows, tmp_path)
     last = {f"{r['instance']}|{r['method']}|{r['seed']}": r for r in rows}
     for r in done[-2:]:
         assert r["opt_c"] == last[f"{r['instance']}|{r['method']}|{r['seed']}"]["opt_c"]
+    assert len(read_decomposition(torn)) == len(rows)  # the row after the torn line is on its own line
+
+
+def test_workers_give_the_rows_of_the_serial_run(small_rows, tmp_path):
+    """Two forked workers write the same rows as one process (order aside), row by row with
+    progress, and a second parallel run adds nothing."""
+    cases, rows, _ = small_rows
+    err = io.StringIO()
+    par = decompose(cases, tmp_path / "par.jsonl", seeds=(0, 1), workers=2, stream=err)
+    fields = ("objective", "opt_c", "opt_cp", "gap", "clustering_loss", "cross_cluster", "routing_loss", "clusters")
+    key = lambda r: f"{r['instance']}|{r['method']}|{r['seed']}"  # noqa: E731
+    assert {key(r): [r.get(f) for f in fields] for r in par} == {key(r): [r.get(f) for f in fields] for r in rows}
+    assert len(read_decomposition(tmp_path / "par.jsonl")) == len(rows)
+    assert f"{len(rows)}/{len(rows)}" in err.getvalue()
+    assert len(decompose(cases, tmp_path / "par.jsonl", seeds=(0, 1), workers=2, stream=None)) == len(rows)
+    with pytest.raises(ValueError, match="workers"):
+        decompose(cases, tmp_path / "x.jsonl", workers=0, stream=None)
 
 
 def test_cases_from_a_results_directory(tmp_path):
