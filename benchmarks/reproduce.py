@@ -18,10 +18,11 @@ emax-sweep        1.5 min   coverage against E_max = 4000..9000 at M=20, N=5, K=
 table1            0.5 min   Table I timings: M=20, N=5, K=2..6, 30 instances each, on ONE worker
 top-chao          32 min    the exact methods (milp, cpsat, bp; 60 s) on TOP sets 1-3 against published optima
 paper-opt         ~3-4 h    the paper's grid (Fig. 3 and 4 settings, 20 instances each): every heuristic
-                            (~5 min) against bp's optimum (60 s at K<=3, 300 s at K=4,5, 600 s at K=6;
-                            up to 3-4 h of the wall)
-decomposition     ~1 h      clustering / cross-cluster / routing loss of the paper methods, from
-                            paper-opt's optima, at N=5 K=3, N=5 K=6 and K=3 N=2..6 (one process)
+                            (5 min) against bp's optimum (60 s at K<=3, 300 s at K=4,5, 600 s at K=6;
+                            K=6 alone took 96 min on 2 workers)
+decomposition     ~30 min   clustering / cross-cluster / routing loss of the paper methods, from
+                            paper-opt's optima, at N=5 K=3, N=5 K=6 and K=3 N=2..6 (one instance per
+                            worker; K=6 N=5 took 12 min on 2, K=3 N=2..6 39 min in one process)
 top-4-7           ~5-8 h    bp alone at 600 s on the 192 shipped files of TOP sets 4-7 (~10-15 CPU-hours)
 ================  ========  =========================================================================
 
