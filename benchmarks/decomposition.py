@@ -47,7 +47,7 @@ from pathlib import Path
 from sarcover.formulations.clustered import oracle_clusters, solve_clustered, split_groups
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
-from sarcover.formulations.records import read_decomposition
+from sarcover.formulations.records import drop_torn_tail, read_decomposition
 from sarcover.formulations.result import Status
 from sarcover.formulations.verify import verify
 from sarcover.heuristics.pipeline import cluster_stage, route_clusters
@@ -303,7 +303,7 @@ def decompose(source, out_path: str | Path, *, methods=tuple(METHODS), seeds=(0,
     todo = [(c, [(m, s) for m in methods for s in seeds if f"{c.name}|{m}|{s}" not in have]) for c in cases]
     todo = [(c, jobs) for c, jobs in todo if jobs]
     total = sum(len(jobs) for _, jobs in todo)
-    _end_torn_line(out_path)
+    drop_torn_tail(out_path)  # a row in flight when a run was killed
     t0 = time.perf_counter()
     count = 0
     with out_path.open("a") as fh:
@@ -325,18 +325,8 @@ def decompose(source, out_path: str | Path, *, methods=tuple(METHODS), seeds=(0,
                     store(decompose_one(case, method, seed=seed, cache=cache, time_limit=time_limit,
                                         unvisited=unvisited))
         else:
-            _decompose_parallel(todo, cache, time_limit, unvisited, workers, store)
+            _decompose_parallel(todo, total, cache, time_limit, unvisited, workers, store)
     return done
-
-
-def _end_torn_line(path: Path) -> None:
-    """End a half-written last line (a killed run's) so the next row starts on a line of its own."""
-    if path.is_file() and path.stat().st_size:
-        with path.open("rb") as fh:
-            fh.seek(-1, 2)
-            if fh.read(1) != b"\n":
-                with path.open("a") as out:
-                    out.write("\n")
 
 
 _QUEUE = None  # the forked workers' channel back to the parent (set before the fork)
@@ -348,9 +338,11 @@ def _decompose_case(case: Case, jobs, cache: ClusteredCache, time_limit: float, 
     return len(jobs)
 
 
-def _decompose_parallel(todo, cache: ClusteredCache, time_limit: float, unvisited: str, workers: int, store) -> None:
-    """One task per instance in a pool of forked processes; each row travels back on a queue as
-    it ends and ``store`` writes it, so the file grows row by row as in the serial loop."""
+def _decompose_parallel(todo, total: int, cache: ClusteredCache, time_limit: float, unvisited: str, workers: int,
+                        store) -> None:
+    """One task per instance in a pool of forked processes; each of the ``total`` rows travels
+    back on a queue as it ends and ``store`` writes it, so the file grows row by row as in the
+    serial loop."""
     import multiprocessing as mp
     import queue
 
@@ -364,20 +356,14 @@ def _decompose_parallel(todo, cache: ClusteredCache, time_limit: float, unvisite
                 own = ClusteredCache(cache.time_limit)  # this instance's stored OPT|C solves only
                 own.store = {k: v for k, v in cache.store.items() if k[0] == case.name}
                 tasks.append(pool.apply_async(_decompose_case, (case, jobs, own, time_limit, unvisited)))
-            while True:
-                try:
-                    store(_QUEUE.get(timeout=0.5))
-                    continue
-                except queue.Empty:
-                    pass
-                for t in tasks:
-                    if t.ready():
-                        t.get()  # re-raises a worker's exception here
-                if all(t.ready() for t in tasks):
-                    while True:  # rows put just before the last task ended
-                        try:
-                            store(_QUEUE.get(timeout=0.5))
-                        except queue.Empty:
-                            return
+            for _ in range(total):
+                while True:
+                    try:
+                        store(_QUEUE.get(timeout=0.5))
+                        break
+                    except queue.Empty:
+                        for t in tasks:
+                            if t.ready():
+                                t.get()  # re-raises a worker's exception here
     finally:
         _QUEUE = None

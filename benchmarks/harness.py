@@ -37,7 +37,7 @@ from multiprocessing.connection import wait
 from pathlib import Path
 
 from sarcover.formulations.errors import SarcoverError
-from sarcover.formulations.records import FIELDS, RESULTS_FILE, SCHEMA_VERSION, outcome, read_rows
+from sarcover.formulations.records import FIELDS, RESULTS_FILE, SCHEMA_VERSION, drop_torn_tail, outcome, read_rows
 from sarcover.benchmarks.registry import get_method, warm_up
 from sarcover.benchmarks.suite import Suite
 
@@ -225,7 +225,7 @@ class ResultsStore:
             if not resume:
                 raise HarnessError(f"{self.directory} already holds results; pass --resume to continue "
                                    f"that run, or choose another -o")
-            self._repair_tail()
+            self.repaired = int(drop_torn_tail(self.path))  # a job in flight when the run was killed
             rows, skipped = read_rows(self.directory)
             if skipped["old_schema"]:
                 raise HarnessError(f"{self.path}: {skipped['old_schema']} rows of another schema version "
@@ -233,16 +233,6 @@ class ResultsStore:
             self.keys = {r["key"] for r in rows}
         self._fh = self.path.open("ab")
         self._last_sync = time.monotonic()
-
-    def _repair_tail(self) -> None:
-        """Drop a half-written last line (a job in flight when the run was killed)."""
-        with self.path.open("rb+") as fh:
-            data = fh.read()
-            if data.endswith(b"\n"):
-                return
-            cut = data.rfind(b"\n") + 1
-            fh.truncate(cut)
-            self.repaired = 1
 
     def append(self, row: dict) -> None:
         self._fh.write((json.dumps(row, allow_nan=False) + "\n").encode())

@@ -138,6 +138,20 @@ def read_rows(directory: str | Path) -> tuple[list[dict], dict[str, int]]:
     return rows, skipped
 
 
+def drop_torn_tail(path: str | Path) -> bool:
+    """Cut a half-written last line (a row in flight when its writer was killed) off a JSON Lines
+    file, so the next row appended starts a line of its own; True when there was one."""
+    path = Path(path)
+    if not path.is_file():
+        return False
+    with path.open("rb+") as fh:
+        data = fh.read()
+        if not data or data.endswith(b"\n"):
+            return False
+        fh.truncate(data.rfind(b"\n") + 1)
+    return True
+
+
 def read_decomposition(path: str | Path) -> list[dict]:
     """The rows of a decomposition file (:mod:`sarcover.benchmarks.decomposition` writes one JSON
     object per instance, method and seed; the reports read them); a half-written line is skipped."""

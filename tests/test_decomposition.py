@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from sarcover.benchmarks.decomposition import (
-    METHODS, Case, cases_from_instances, cases_from_results, decompose, plan_clusters, read_decomposition,
+    METHODS, Case, cases_from_instances, cases_from_results, decompose, plan_clusters, read_decomposition, row_key,
 )
 from sarcover.formulations.clustered import inside, solve_clustered
 from sarcover.formulations.generate import generate
@@ -123,7 +123,7 @@ def test_resume_skips_stored_rows_and_survives_a_torn_line(small_rows, tmp_path)
     last = {f"{r['instance']}|{r['method']}|{r['seed']}": r for r in rows}
     for r in done[-2:]:
         assert r["opt_c"] == last[f"{r['instance']}|{r['method']}|{r['seed']}"]["opt_c"]
-    assert len(read_decomposition(torn)) == len(rows)  # the row after the torn line is on its own line
+    assert len(read_decomposition(torn)) == len(rows)  # the torn line is cut, the rows after it are whole
 
 
 def test_workers_give_the_rows_of_the_serial_run(small_rows, tmp_path):
@@ -133,8 +133,8 @@ def test_workers_give_the_rows_of_the_serial_run(small_rows, tmp_path):
     err = io.StringIO()
     par = decompose(cases, tmp_path / "par.jsonl", seeds=(0, 1), workers=2, stream=err)
     fields = ("objective", "opt_c", "opt_cp", "gap", "clustering_loss", "cross_cluster", "routing_loss", "clusters")
-    key = lambda r: f"{r['instance']}|{r['method']}|{r['seed']}"  # noqa: E731
-    assert {key(r): [r.get(f) for f in fields] for r in par} == {key(r): [r.get(f) for f in fields] for r in rows}
+    assert ({row_key(r): [r.get(f) for f in fields] for r in par}
+            == {row_key(r): [r.get(f) for f in fields] for r in rows})
     assert len(read_decomposition(tmp_path / "par.jsonl")) == len(rows)
     assert f"{len(rows)}/{len(rows)}" in err.getvalue()
     assert len(decompose(cases, tmp_path / "par.jsonl", seeds=(0, 1), workers=2, stream=None)) == len(rows)
