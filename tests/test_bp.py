@@ -238,6 +238,30 @@ def test_exact_pricing_matches_enumeration(seed, bidirectional):
     assert all(r in value and value[r] <= best + 1e-9 for r in heur.routes)
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_exact_pricing_keeps_near_best_routes_without_losing_the_best(seed):
+    """``keep`` holds the exact pricing's pruning threshold below the best path found: the best
+    value stays the best elementary prize, every route returned is a real improving path, the
+    best comes first, and more of the near-best routes come back (the point of it: more columns
+    per exact call)."""
+    from sarcover.formulations.bp.pricing import full_ng, price
+
+    cost, ret, profit, budget = _tiny_pricing(seed, n_nodes=9)
+    paths = _brute_paths(cost, profit, budget)
+    best = max(p for p, _ in paths)
+    value = {path: p for p, path in paths}
+    allowed = np.ones(cost.shape[0], dtype=bool)
+    routes = {}
+    for keep in (0.0, 0.5, 1.0):
+        res = price(cost, ret, profit, budget, full_ng(cost.shape[0]), allowed, heuristic=False,
+                    max_labels=1_000_000, n_cols=1000, min_gain=0.0, keep=keep)
+        assert res.exact and res.best == pytest.approx(best)
+        assert all(r in value and value[r] > 0.0 for r in res.routes)
+        assert value[res.routes[0]] == pytest.approx(best)
+        routes[keep] = len(res.routes)
+    assert routes[0.0] < routes[0.5] <= routes[1.0]
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_completion_bound_covers_every_suffix(seed):
     """_completion never undercuts the best elementary suffix of a path prefix (enumerated)."""
@@ -519,10 +543,10 @@ def _prize(inst, result):
 
 
 def test_primal_plan_becomes_the_incumbent_when_the_root_needs_it():
-    """``primal`` runs once, after the root and its first dive leave the proof open (p1.2.l);
+    """``primal`` runs once, after the root and its first dive leave the proof open (p1.2.p);
     a verified plan it returns is taken as incumbent and its routes as columns; the run still
     proves the published optimum."""
-    inst = _top("p1.2.l")
+    inst = _top("p1.2.p")
     ref = solve_bp(inst, time_limit=30)
     assert ref.status == Status.OPTIMAL
     calls = []
@@ -533,8 +557,8 @@ def test_primal_plan_becomes_the_incumbent_when_the_root_needs_it():
 
     r = solve_bp(inst, time_limit=60, primal=primal)
     assert len(calls) == 1 and 0 < calls[0] <= 0.1 * 60 + 1e-9
-    assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p1.2.l"])
-    assert r.info["primal_prize"] == pytest.approx(OPTIMAL["p1.2.l"])
+    assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p1.2.p"])
+    assert r.info["primal_prize"] == pytest.approx(OPTIMAL["p1.2.p"])
     assert r.info["primal_s"] is not None and r.info["primal_error"] is None
 
 
@@ -550,7 +574,7 @@ def test_primal_is_not_run_when_the_root_proves():
 def test_a_bad_primal_costs_nothing_but_its_time(kind):
     """A failing heuristic, one returning a plan the verifier rejects, or none at all: the run
     goes on and proves the optimum; the rejected plan is never the incumbent."""
-    inst = _top("p1.2.l")
+    inst = _top("p1.2.p")
 
     def primal(seconds):
         if kind == "raises":
@@ -560,7 +584,7 @@ def test_a_bad_primal_costs_nothing_but_its_time(kind):
         return None
 
     r = solve_bp(inst, time_limit=60, primal=primal)
-    assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p1.2.l"])
+    assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p1.2.p"])
     assert r.info["primal_s"] is not None and r.info["primal_prize"] is None
     assert (r.info["primal_error"] == "RuntimeError: boom") == (kind == "raises")
 

@@ -42,6 +42,11 @@ class BPOptions:
       None: the first exact call runs both and keeps the faster.
     - ``ng_columns``: improving ng-routes that repeat a point also enter the master (with
       visit counts), so that the LP stays the relaxation that the pricing bounds.
+    - ``exact_keep``: exact pricing keeps the routes within this share of the best route's gain
+      (over the vehicle dual) below it, instead of pruning against the best itself: more
+      columns per call, more labels (:func:`.pricing.price`); 0 prunes against the best, 1
+      never raises the threshold. 0.5: fewer exact calls at the root, more cut rounds in time
+      (docs/bp.md).
     - ``ng_cap``: the most points an ng set grows to when LP routes repeat a point.
     - ``grow_share``: ng sets only grow within this share of the limit (larger sets make pricing
       slower; after that, branching decides).
@@ -85,6 +90,7 @@ class BPOptions:
     ng_size: int = 8
     bidirectional: bool | None = None
     ng_columns: bool = True
+    exact_keep: float = 0.5
     ng_cap: int = 12
     grow_share: float = 0.3
     cut_rounds: int | None = None

@@ -16,12 +16,15 @@ if TYPE_CHECKING:
 
 class Pricer:
     """Pricing calls of one run. ``bidirectional``: the exact pricing direction; None until the
-    first exact call has measured both."""
+    first exact call has measured both. ``keep``: the exact calls' share of near-best routes
+    (:func:`.pricing.price`)."""
 
-    def __init__(self, search: "Search", bidirectional: bool | None, ng_columns: bool):
+    def __init__(self, search: "Search", bidirectional: bool | None, ng_columns: bool,
+                 keep: float = 0.0):
         self.search = search
         self.bidirectional = bidirectional
         self.ng_columns = ng_columns
+        self.keep = keep
 
     def price(self, cost, ret, prof, allowed, *, heuristic: bool, y0: float, sig,
               deadline: float | None = None):
@@ -36,7 +39,7 @@ class Pricer:
                     deadline=s.deadline if deadline is None else deadline,
                     bidirectional=bool(self.bidirectional) and not heuristic,
                     cut_members=s.master.cut_members, cut_memory=s.master.cut_memory,
-                    cut_duals=sig)
+                    cut_duals=sig, keep=0.0 if heuristic else self.keep)
         s.stats.pricing_s += time.perf_counter() - t
         s.stats.labels += res.n_labels
         return res

@@ -24,7 +24,8 @@ the label has not remembered and that still fit: a node u is skipped unless ``re
 assumed) is within the label's remaining energy; each kept node costs at least its cheapest
 incoming arc, and one last arc into the end (the cheapest of a fitting node) is set aside first.
 The threshold starts at ``min_gain`` (the vehicle dual, or more for a targeted call) and, in exact
-mode, rises to the best complete path found so far. The value reported is max(best path found,
+mode, rises with the best complete path found so far (to it, or a ``keep`` share of its gain below
+it, which also returns the near-best routes). The value reported is max(best path found,
 starting threshold): an upper bound on the best *elementary* path (an elementary path's suffix
 visits distinct nodes that are not in the remembered set of any label dominating its prefix, so the
 once-per-node knapsack bounds it), which is all the master's bound needs.
@@ -246,12 +247,15 @@ def _byte_sums(duals: np.ndarray) -> np.ndarray:
 @njit(cache=True)
 def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
            lastord, cend, threshold, deadline, half, cmem, mmem, sig, g1, s1, g2, delta, nb,
-           fixed):
+           keep):
     """Labelling from node 0 to node n-1.
 
     Returns (count, node, pred, energy, prize, mask, alive, hit_cap, threshold). Labels whose
-    prize plus the completion bound cannot exceed ``threshold`` are not stored (in exact mode the
-    threshold rises to the best complete path found, unless ``fixed``); only labels with
+    prize plus the completion bound cannot exceed ``threshold`` are not stored. In exact mode the
+    threshold rises with the best complete path found, to ``best - keep * (best - start)``
+    (``start``: the threshold given): ``keep`` = 0 prunes against the best path itself (the best
+    value, few other routes), ``keep`` > 0 keeps the routes within that share of the best's gain
+    over the start (more columns per call, more labels), 1 never raises it; only labels with
     energy <= ``half`` are extended (``half`` = budget for a one-way search). Labels are kept in
     creation order (global arrays, for the paths) and, for the dominance tests, in contiguous
     per-node buckets (energy, prize, mask, label id) so that the scans stay in cache.
@@ -266,6 +270,7 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
     n = cost.shape[0]
     end = n - 1
     W = ng.shape[1]
+    start = threshold
     cap = 1024
     node = np.empty(cap, np.int32)
     pred = np.empty(cap, np.int32)
@@ -422,8 +427,11 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             pred[count] = qi
             en[count] = e2
             pr[count] = p2
-            if not (heuristic or fixed) and p2 > threshold and e2 + cost[w, end] <= budget:
-                threshold = p2  # exact mode looks for the best path: prune against the best found
+            if not heuristic and p2 > threshold and e2 + cost[w, end] <= budget:
+                # exact mode looks for the best path: prune against (nearly) the best found
+                t2 = p2 - keep * (p2 - start)
+                if t2 > threshold:
+                    threshold = t2
             alive[count] = True
             srb[count] = s2
             for k in range(W):
@@ -700,7 +708,7 @@ def _label_table(cost, profit, budget, ng, allowed, threshold, max_labels, deadl
     count, node, pred, en, pr, _, _, hit, _ = _label(
         cost, ret, profit, budget, ng, allowed, False, max_labels, order, cin, reach, lastord,
         cend, float(threshold), float(deadline), float(budget), *cuts,
-        *suffix_tables(cost, profit, allowed, budget), True,
+        *suffix_tables(cost, profit, allowed, budget), 1.0,
     )
     if hit:
         return None
@@ -766,7 +774,8 @@ def _chain(node, pred, j):
 
 
 def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_cols, min_gain,
-          deadline=np.inf, bidirectional=False, cut_members=None, cut_memory=None, cut_duals=None):
+          deadline=np.inf, bidirectional=False, cut_members=None, cut_memory=None, cut_duals=None,
+          keep=0.0):
     """Run the labelling; return a :class:`PricingResult`.
 
     ``profit`` holds the reduced prize of every point (0 at start and end); the value reported is
@@ -784,6 +793,10 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     point w, ``cut_memory[w]`` of those whose memory holds it (None: every cut remembers every
     point), ``cut_duals`` their duals; a path's prize is then its reduced prize with the cuts'
     duals paid. The join does not track cuts, so with cuts the search is one-way.
+
+    ``keep`` (exact mode): how far below the best path found the pruning threshold stays, as a
+    share of the best's gain over ``min_gain`` (:func:`_label`); 0 finds the best value with the
+    fewest labels, more returns more of the near-best routes. The best value is exact either way.
     """
     n = cost.shape[0]
     if cut_members is None or cut_duals is None or not np.any(cut_duals > 0):
@@ -808,7 +821,7 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     count, node, pred, en, pr, fmask, falive, hit, thr = _label(
         cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
         lastord, cend, float(min_gain), float(deadline), half, cmem, mmem, sig,
-        *suffix_tables(cost, profit, allowed, budget), False,
+        *suffix_tables(cost, profit, allowed, budget), float(keep),
     )
     total = int(count)
     found = []  # (value, path)
@@ -824,7 +837,7 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
         bcount, bnode, bpred, ben, bpr, bmask, balive, bhit, thr = _label(
             cost_b, ret_b, profit_b, budget, ng, allowed_b, heuristic, max_labels, order_b, cin_b,
             reach_b, lastord_b, cend_b, float(thr), float(deadline), half, cmem[perm], mmem[perm], sig,
-            *suffix_tables(cost_b, profit_b, allowed_b, budget), False,
+            *suffix_tables(cost_b, profit_b, allowed_b, budget), float(keep),
         )
         total += int(bcount)
         hit = hit or bhit
