@@ -118,11 +118,11 @@ def test_resume_skips_stored_rows_and_survives_a_torn_line(small_rows, tmp_path)
     assert len(read_decomposition(torn)) == len(lines) - 2
     err = io.StringIO()
     done = decompose(cases, torn, seeds=(0, 1), stream=err)
-    keys = [f"{r['instance']}|{r['method']}|{r['seed']}" for r in done]
+    keys = [row_key(r) for r in done]
     assert len(set(keys)) == len(rows) and "2/2" in err.getvalue()
-    last = {f"{r['instance']}|{r['method']}|{r['seed']}": r for r in rows}
+    last = {row_key(r): r for r in rows}
     for r in done[-2:]:
-        assert r["opt_c"] == last[f"{r['instance']}|{r['method']}|{r['seed']}"]["opt_c"]
+        assert r["opt_c"] == last[row_key(r)]["opt_c"]
     assert len(read_decomposition(torn)) == len(rows)  # the torn line is cut, the rows after it are whole
 
 

@@ -20,7 +20,7 @@ class Pricer:
     (:func:`.pricing.price`)."""
 
     def __init__(self, search: "Search", bidirectional: bool | None, ng_columns: bool,
-                 keep: float = 0.0):
+                 keep: float):
         self.search = search
         self.bidirectional = bidirectional
         self.ng_columns = ng_columns

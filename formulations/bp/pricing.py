@@ -797,6 +797,8 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     ``keep`` (exact mode): how far below the best path found the pruning threshold stays, as a
     share of the best's gain over ``min_gain`` (:func:`_label`); 0 finds the best value with the
     fewest labels, more returns more of the near-best routes. The best value is exact either way.
+    A bidirectional search's backward half starts from the forward half's final threshold, so its
+    share is measured from there.
     """
     n = cost.shape[0]
     if cut_members is None or cut_duals is None or not np.any(cut_duals > 0):
