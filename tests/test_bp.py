@@ -648,8 +648,54 @@ def test_strong_branching_proves_the_same_optimum():
     before = m.col_ub.copy()
     lp = float(np.dot(m.route_prize, x[: m.n_routes]))
     pick = branch(bp.search, NodeState(), x, lp, bp.options.strong)
-    assert pick in cands[: bp.options.strong]
+    assert pick in cands
     assert np.array_equal(m.col_ub, before)
+
+
+def test_group_bounds_set_the_group_rows():
+    """A node's bounds on a group's visits become the group row's bounds (the cover row's lower
+    bound 1 stays the floor), bind in the LP, count in the Lagrangian bound, and go when the
+    master is set to a node without them."""
+    from sarcover.formulations.bp.master import Master
+    from sarcover.formulations.bp.node import NodeState
+
+    m = Master(4, np.ones(4), [(0, 1, 2), (3,)], 4)  # group 0: points 1-3, group 1: point 4
+    m.add_routes([(1,), (2,), (3,), (4,)])
+    row = 1 + m.V  # group 0's row
+    values = {}
+    for hi in (np.inf, 2.0, 1.0):
+        st = NodeState().child(group_bounds=[(0, -np.inf, hi)])
+        m.apply(st)
+        assert (m.cur_lo[row], m.cur_hi[row]) == (1.0, hi)
+        value, x, xa, y = m.solve()
+        assert xa.max() < 1e-9 and m.group_visits(x)[0] == pytest.approx(min(hi, 3.0))
+        # nothing left to price: the certificate is the LP value
+        assert m.lagrangian_bound(y, 0.0) == pytest.approx(value)
+        values[hi] = value
+    assert values == {np.inf: 4.0, 2.0: 3.0, 1.0: 2.0}
+    m.apply(NodeState().child(group_bounds=[(0, 2.0, np.inf)]))
+    assert (m.cur_lo[row], m.cur_hi[row]) == (2.0, np.inf)
+    m.apply(NodeState())
+    assert (m.cur_lo[row], m.cur_hi[row]) == (1.0, np.inf) and m.solve()[0] == pytest.approx(4.0)
+
+
+def test_group_branching_proves_the_same_optimum():
+    """Branching on a target's number of views changes the tree, never the result: on a SAR
+    instance under a weak relaxation (ng sets of 2, no cuts), so that the tree is searched, bp
+    proves the same optimum with and without it, and that optimum is the one the default run
+    proves at its root. Only the run with it splits on groups."""
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
+
+    inst = to_top(generate(8, 4, 2, 2))
+    ref = solve_bp(inst, time_limit=60)
+    assert ref.status == Status.OPTIMAL
+    weak = dict(strong=5, ng_size=2, ng_cap=2, cut_rounds=0)
+    for groups in (True, False):
+        r = solve_bp(inst, time_limit=60, options=BPOptions(group_branching=groups, **weak))
+        assert r.status == Status.OPTIMAL and verify(inst, r.plan).valid
+        assert _prize(inst, r) == pytest.approx(_prize(inst, ref))
+        assert r.info["nodes"] > 1 and (r.info["group_branches"] > 0) == groups
 
 
 def test_milp_start_plan_is_a_floor():

@@ -114,7 +114,8 @@ class Master:
         # arcs no plan better than the incumbent uses (reduced-cost arc elimination)
         self.eliminated = np.zeros((n_nodes + 2, n_nodes + 2), dtype=bool)
         self.col_ub = np.zeros(0)
-        self.cur_lo = self.row_lo.copy()
+        self.cur_lo = self.row_lo.copy()  # row bounds at the node the master is set to
+        self.cur_hi = self.row_hi.copy()
         self.cuts: list[tuple[int, ...]] = []  # subset-row triples (solver points)
         self.cut_members = np.zeros(self.V + 2, dtype=np.uint64)  # bitset of cuts per point
         self.cut_memory = np.zeros(self.V + 2, dtype=np.uint64)  # cuts remembering each point
@@ -273,6 +274,7 @@ class Master:
         self.row_lo = np.concatenate([self.row_lo, np.full(n, -INF)])
         self.row_hi = np.concatenate([self.row_hi, np.ones(n)])
         self.cur_lo = np.concatenate([self.cur_lo, np.full(n, -INF)])
+        self.cur_hi = np.concatenate([self.cur_hi, np.ones(n)])
         return n
 
     def purge_cuts(self, y: np.ndarray, tol: float = 1e-9) -> int:
@@ -289,8 +291,8 @@ class Master:
         self.h.deleteRows(int(rows.size), rows)
         keep_row = np.ones(self.n_rows, dtype=bool)
         keep_row[rows] = False
-        self.row_lo, self.row_hi, self.cur_lo = (a[keep_row] for a in (self.row_lo, self.row_hi,
-                                                                      self.cur_lo))
+        self.row_lo, self.row_hi, self.cur_lo, self.cur_hi = (
+            a[keep_row] for a in (self.row_lo, self.row_hi, self.cur_lo, self.cur_hi))
         self.n_rows -= int(rows.size)
         kept = [c for c in range(len(self.cuts)) if duals[c] > tol]
         self.cuts = [self.cuts[c] for c in kept]
@@ -371,12 +373,15 @@ class Master:
             cols = (changed + self.n_art).astype(np.int32)
             self.h.changeColsBounds(cols.size, cols, np.zeros(cols.size), ub[changed])
             self.col_ub = ub
-        lo = self.row_lo.copy()
+        lo, hi = self.row_lo.copy(), self.row_hi.copy()
         for p in state.forced_nodes:
             lo[p] = 1.0
-        self.cur_lo = lo
-        self.h.changeRowsBounds(self.V, np.arange(1, self.V + 1, dtype=np.int32), lo[1 : self.V + 1],
-                                self.row_hi[1 : self.V + 1])
+        for g, g_lo, g_hi in state.group_bounds:  # views of target g within [g_lo, g_hi]
+            row = 1 + self.V + g
+            lo[row], hi[row] = max(lo[row], g_lo), min(hi[row], g_hi)
+        self.cur_lo, self.cur_hi = lo, hi
+        rows = np.arange(1, 1 + self.V + self.G, dtype=np.int32)
+        self.h.changeRowsBounds(rows.size, rows, lo[rows], hi[rows])
         assert k == self.col_ub.size
 
     # -- solving ---------------------------------------------------------------------------
@@ -389,7 +394,7 @@ class Master:
         sol = self.h.getSolution()
         x = np.asarray(sol.col_value)
         y = np.asarray(sol.row_dual).copy()
-        lo, hi = self.cur_lo, self.row_hi
+        lo, hi = self.cur_lo, self.cur_hi
         y[np.isinf(lo) & (y < 0)] = 0.0  # "<=" rows: y >= 0
         y[np.isinf(hi) & (y > 0)] = 0.0  # ">=" rows: y <= 0
         value = self.h.getInfo().objective_function_value
@@ -405,7 +410,7 @@ class Master:
 
     def lagrangian_bound(self, y: np.ndarray, best_path_prize: float) -> float:
         """Certified upper bound from duals y and an upper bound on the best path's reduced prize."""
-        lo, hi = self.cur_lo, self.row_hi
+        lo, hi = self.cur_lo, self.cur_hi
         term = np.where(y > 0, y * np.where(np.isinf(hi), 0.0, hi), y * np.where(np.isinf(lo), 0.0, lo))
         rc_star = max(0.0, best_path_prize - y[0])
         return float(term.sum() + self.N * rc_star)
@@ -437,6 +442,11 @@ class Master:
         """(V+2,) visit value of each point in an LP solution."""
         k = self.n_routes
         return x[:k] @ self._visit[:k]
+
+    def group_visits(self, x: np.ndarray) -> np.ndarray:
+        """(G,) visits of each group's points (views of each target) in an LP solution."""
+        visits = self.node_visits(x)
+        return np.array([visits[pts].sum() for pts in self.groups])
 
     def arc_flows(self, x: np.ndarray) -> dict[tuple[int, int], float]:
         flows: dict[tuple[int, int], float] = {}

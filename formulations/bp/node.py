@@ -1,8 +1,10 @@
 """A branch-and-bound node: its branching decisions, and the pricing graph they leave.
 
-Both kinds of decision keep the pricing a plain labelling on a modified graph: a forbidden node
-leaves the graph, a forced node only changes its master row (``= 1``); a forbidden arc is removed,
-a forced arc (a, b) removes every other arc out of a and into b.
+Every kind of decision keeps the pricing a plain labelling on a modified graph: a forbidden node
+leaves the graph, a forced node only changes its master row (``= 1``); a bound on a group's
+visits only changes the group's row (its dual joins the prizes of the group's points, as the
+cover row's does); a forbidden arc is removed, a forced arc (a, b) removes every other arc out of
+a and into b.
 """
 
 from __future__ import annotations
@@ -26,11 +28,13 @@ class NodeState:
     forced_nodes: frozenset = frozenset()
     forbidden_arcs: frozenset = frozenset()
     forced_arcs: frozenset = frozenset()
+    group_bounds: frozenset = frozenset()  # (group, lo, hi): the group's visits within [lo, hi]
     depth: int = 0
 
     def child(self, **add) -> "NodeState":
         kw = {k: getattr(self, k) | frozenset(add.get(k, ())) for k in
-              ("forbidden_nodes", "forced_nodes", "forbidden_arcs", "forced_arcs")}
+              ("forbidden_nodes", "forced_nodes", "forbidden_arcs", "forced_arcs",
+               "group_bounds")}
         return NodeState(**kw, depth=self.depth + 1)
 
 

@@ -67,8 +67,11 @@ class BPOptions:
     - ``dive_share``: time for a dive at the root (30 s without a limit); later dives get less.
     - ``dive_every``, ``milp_every``: a dive every this many nodes, a MILP over the generated
       routes every this many nodes (when new routes came in).
-    - ``strong``: branching candidates compared by their children's restricted LPs (1: the most
-      fractional candidate, no estimates).
+    - ``strong``: branching candidates of each kind compared by their children's restricted LPs
+      (1: the most fractional candidate, no estimates).
+    - ``group_branching``: also branch on a group's number of visits (:mod:`.branching`); off
+      by default: on the M = 20, K = 3 tuning instances it proved no more, and at K >= 4 the
+      tree is too small for the choice to matter (docs/bp.md).
 
     Arc elimination:
 
@@ -103,6 +106,7 @@ class BPOptions:
     dive_every: int = 4
     milp_every: int = 10
     strong: int = 5
+    group_branching: bool = False
     elim_share: float = 0.1
     pool_routes: int = 2000
     enum_share: float = 0.0

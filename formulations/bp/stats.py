@@ -18,6 +18,7 @@ class Stats:
     milp_s: float = 0.0
     strong_lps: int = 0
     strong_s: float = 0.0
+    group_branches: int = 0  # nodes split on a group's number of visits
     open_nodes: int = 0  # nodes left unsolved at the limit (0 when proven)
     milp_improved: int = 0  # MILP calls that raised the incumbent
     milp_columns: int | None = None  # routes the last MILP could use (reduced-cost filter)
@@ -57,7 +58,8 @@ class Stats:
             "milp_s": round(self.milp_s, 3), "milp_improved": self.milp_improved,
             "milp_columns": self.milp_columns, "dives": self.dives,
             "dive_improved": self.dive_improved, "strong_lps": self.strong_lps,
-            "strong_s": round(self.strong_s, 3), "open_nodes": self.open_nodes,
+            "strong_s": round(self.strong_s, 3), "group_branches": self.group_branches,
+            "open_nodes": self.open_nodes,
             "cuts": self.cuts, "cuts_purged": self.cuts_purged,
             "arcs_eliminated": self.arcs_eliminated, "elim_s": round(self.elim_s, 3),
             "elim_labels": self.elim_labels, "pool_routes": self.pool_routes,

@@ -152,10 +152,11 @@ class BranchAndPrice:
             if inc.offer_if_integral(x, xa):
                 continue
             lp_value = float(np.dot(m.route_prize, x[: m.n_routes]))
-            children = branch(s, state, x, lp_value, opts.strong)
+            children = branch(s, state, x, lp_value, opts.strong, opts.group_branching)
             if children is None:
                 unresolved.append(bound)
                 continue
+            s.stats.group_branches += children[0].group_bounds != state.group_bounds
             for ch in children:
                 heapq.heappush(heap, self._node_key(bound, ch.depth, counter, ch))
                 counter += 1
