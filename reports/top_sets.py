@@ -85,7 +85,7 @@ def _table(st: pd.DataFrame) -> list[str]:
     head = ["set", "files", "published optima (best known only)", "bp proven", "proven = published optimum",
             "new proofs", "median s (proven)", "unproven", "certified gap mean / max", "conflicts", "news"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    for _, r in st.iterrows():
+    for r in st.to_dict("records"):  # per column types (iterrows makes every count a float)
         lines.append(f"| {r['set']} | {r['files']} | {r['published_optima']} ({r['best_known_only']}) | "
                      f"{r['bp_proven']} ({_pct(r['share_proven'])}) | {r['proven_equal_published']} | {r['new_proofs']} | "
                      + ("–" if pd.isna(r["median_s_proven"]) else f"{r['median_s_proven']:.0f}")
