@@ -20,16 +20,29 @@ def is_benchmark_name(text: str) -> bool:
     return "/" not in text and "\\" not in text and not text.endswith((".txt", ".json"))
 
 
+def _is_file(path: Path) -> bool:
+    """``path.is_file()``, False where the name cannot be a file at all (too long for the
+    file system: ``is_file`` raises there instead)."""
+    try:
+        return path.is_file()
+    except OSError:
+        return False
+
+
 def benchmark_file(name: str) -> Path | None:
     """The shipped TOP file of benchmark ``name``, or None if there is none."""
     path = TOP_DIR / f"{name}.txt"
-    return path if is_benchmark_name(name) and path.is_file() else None
+    return path if is_benchmark_name(name) and _is_file(path) else None
 
 
 def instance_path(name_or_path: str | Path) -> Path:
     """A path as given, or the shipped file of a benchmark name (when no such path exists)."""
     path = Path(name_or_path)
-    if not path.exists():
+    try:
+        exists = path.exists()
+    except OSError:  # a name too long for the file system: no such file
+        exists = False
+    if not exists:
         shipped = benchmark_file(str(name_or_path))
         if shipped is not None:
             return shipped

@@ -95,3 +95,12 @@ def test_bad_input_one_line_exit_2(tmp_path, args, needle):
     assert out.returncode == 2
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0] and "Traceback" not in out.stderr
+
+
+def test_a_name_too_long_for_the_file_system_is_bad_input(capsys):
+    """A file name longer than the file system allows (found by the argument-list property
+    test) is bad input like a missing file: one line naming it, exit 2, no traceback."""
+    name = "1" + "0" * 400
+    assert main(["solve", name]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "cannot read" in err[0] and name in err[0]
