@@ -20,11 +20,12 @@ def is_benchmark_name(text: str) -> bool:
     return "/" not in text and "\\" not in text and not text.endswith((".txt", ".json"))
 
 
-def _is_file(path: Path) -> bool:
-    """``path.is_file()``, False where the name cannot be a file at all (too long for the
-    file system: ``is_file`` raises there instead)."""
+def _names(path: Path, *, a_file: bool = False) -> bool:
+    """``path.exists()`` (``path.is_file()`` if ``a_file``), False where the name cannot name
+    anything (too long for the file system: pathlib raises there instead), so that such a name
+    reaches the reader's own error."""
     try:
-        return path.is_file()
+        return path.is_file() if a_file else path.exists()
     except OSError:
         return False
 
@@ -32,17 +33,13 @@ def _is_file(path: Path) -> bool:
 def benchmark_file(name: str) -> Path | None:
     """The shipped TOP file of benchmark ``name``, or None if there is none."""
     path = TOP_DIR / f"{name}.txt"
-    return path if is_benchmark_name(name) and _is_file(path) else None
+    return path if is_benchmark_name(name) and _names(path, a_file=True) else None
 
 
 def instance_path(name_or_path: str | Path) -> Path:
     """A path as given, or the shipped file of a benchmark name (when no such path exists)."""
     path = Path(name_or_path)
-    try:
-        exists = path.exists()
-    except OSError:  # a name too long for the file system: no such file
-        exists = False
-    if not exists:
+    if not _names(path):
         shipped = benchmark_file(str(name_or_path))
         if shipped is not None:
             return shipped

@@ -10,6 +10,7 @@ command's.
 from __future__ import annotations
 
 import argparse
+import errno
 import json
 import math
 import os
@@ -370,6 +371,12 @@ def main(argv: list[str] | None = None) -> int:
     except SarcoverError as exc:
         print(f"sarcover: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except OSError as exc:
+        if exc.errno != errno.ENAMETOOLONG:
+            raise
+        # a path argument too long for the file system, whichever command checks it first
+        print(f"sarcover: error: {_one_line(exc.filename)}: {exc.strerror}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("sarcover: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
@@ -380,8 +387,9 @@ def main(argv: list[str] | None = None) -> int:
         return exc.code if isinstance(exc.code, int) else EXIT_OK
 
 
-def _one_line(exc: Exception) -> str:
-    """The error's message on one line (a file name or an argument may hold a line break)."""
+def _one_line(exc: object) -> str:
+    """The error's message (or a file name) on one line (a name or an argument may hold a line
+    break)."""
     return " ".join(str(exc).splitlines())
 
 

@@ -99,8 +99,13 @@ def test_bad_input_one_line_exit_2(tmp_path, args, needle):
 
 def test_a_name_too_long_for_the_file_system_is_bad_input(capsys):
     """A file name longer than the file system allows (found by the argument-list property
-    test) is bad input like a missing file: one line naming it, exit 2, no traceback."""
+    test) is bad input like a missing file: one line naming it, exit 2, no traceback, whichever
+    command gets it (an instance, a suite, a results or output directory)."""
     name = "1" + "0" * 400
     assert main(["solve", name]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "cannot read" in err[0] and name in err[0]
+    for argv in (["bench", name, "-o", "unused"], ["report", name], ["bench", "quick", "-o", name]):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and name in err[0] and "too long" in err[0], argv
