@@ -794,9 +794,15 @@ def test_exact_pricing_with_cuts_matches_enumeration(seed):
     assert all(vals[r] > gain - 1e-9 for r in ex.routes)
     ng = price(cost, ret, profit, budget, nearest_ng(cost, 2), allowed, heuristic=False, **kw)
     assert ng.exact and ng.best >= best - 1e-9
-    # bidirectional search is switched off with cuts (its join does not track them): same value
+    # bidirectional search: its join pays the pairs it makes, so the same best value and routes
+    # worth what they claim; its ng relaxation stays an upper bound
     bi = price(cost, ret, profit, budget, full_ng(n), allowed, heuristic=False, bidirectional=True, **kw)
-    assert bi.best == pytest.approx(ex.best)
+    assert bi.exact and bi.best == pytest.approx(ex.best)
+    assert bi.routes and vals[bi.routes[0]] == pytest.approx(best)
+    assert all(vals[r] > gain - 1e-9 for r in bi.routes)
+    bng = price(cost, ret, profit, budget, nearest_ng(cost, 2), allowed, heuristic=False,
+                bidirectional=True, **kw)
+    assert bng.exact and bng.best >= best - 1e-9
 
 
 def test_master_cut_rows_hold_lm_coefficients():

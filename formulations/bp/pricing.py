@@ -39,7 +39,8 @@ candidates meet it first. Paths are kept in creation order.
 
 Bidirectional mode (exact only): the same routine runs forward from the start and backward from
 the end (on the reversed graph), extending labels only up to half the budget, and the halves are
-joined through one arc (see :func:`price`). The branch-and-price picks the direction by timing.
+joined through one arc (see :func:`price`), with or without subset-row cuts (the join pays the
+cut pairs it makes). The branch-and-price picks the direction by timing.
 
 A label is only created if the end is still reachable within the budget (``ret`` = cheapest
 energy to the end in the allowed graph), so every stored label is a complete route candidate:
@@ -250,15 +251,16 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
            keep):
     """Labelling from node 0 to node n-1.
 
-    Returns (count, node, pred, energy, prize, mask, alive, hit_cap, threshold). Labels whose
-    prize plus the completion bound cannot exceed ``threshold`` are not stored. In exact mode the
-    threshold rises with the best complete path found, to ``best - keep * (best - start)``
-    (``start``: the threshold given): ``keep`` = 0 prunes against the best path itself (the best
-    value, few other routes), ``keep`` > 0 keeps the routes within that share of the best's gain
-    over the start (more columns per call, more labels), 1 never raises it; only labels with
-    energy <= ``half`` are extended (``half`` = budget for a one-way search). Labels are kept in
-    creation order (global arrays, for the paths) and, for the dominance tests, in contiguous
-    per-node buckets (energy, prize, mask, label id) so that the scans stay in cache.
+    Returns (count, node, pred, energy, prize, mask, alive, hit_cap, threshold, cut parities).
+    Labels whose prize plus the completion bound cannot exceed ``threshold`` are not stored. In
+    exact mode the threshold rises with the best complete path found, to
+    ``best - keep * (best - start)`` (``start``: the threshold given): ``keep`` = 0 prunes against
+    the best path itself (the best value, few other routes), ``keep`` > 0 keeps the routes within
+    that share of the best's gain over the start (more columns per call, more labels), 1 never
+    raises it; only labels with energy <= ``half`` are extended (``half`` = budget for a one-way
+    search). Labels are kept in creation order (global arrays, for the paths) and, for the
+    dominance tests, in contiguous per-node buckets (energy, prize, mask, label id) so that the
+    scans stay in cache.
 
     Limited-memory subset-row cuts (``cmem[w]``: bitset of the cuts whose triple holds w;
     ``mmem[w]``: of the cuts whose memory holds w, a superset; ``sig``: their duals, >= 0): a
@@ -460,17 +462,24 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
         if hit:
             break
     return (count, node[:count], pred[:count], en[:count], pr[:count], mask[:count],
-            alive[:count], hit, threshold)
+            alive[:count], hit, threshold, srb[:count])
 
 
 @njit(cache=True)
-def _join(fnode, fen, fpr, fmask, falive, bnode, ben, bpr, bmask, bstart, border, cost, budget,
-          half, threshold, max_pairs):
+def _join(fnode, fen, fpr, fmask, falive, fsr, bnode, ben, bpr, bmask, bsr, bstart, border,
+          cost, budget, half, threshold, max_pairs, sig):
     """Join forward labels (energy <= half) with backward labels through one arc.
 
     Backward labels of point u are ``border[bstart[u]:bstart[u+1]]`` sorted by prize, best
     first (the end's own root label included). Returns the pairs worth more than the (rising)
     threshold and the final threshold.
+
+    Subset-row cuts: ``fsr``/``bsr`` are the labels' cut parities (:func:`_label`, the backward
+    ones counted from the end). A cut odd on both sides has its last forward visit and first
+    backward visit in one stretch of its memory (a parity is forgotten at any point outside
+    it, and both ends of the joining arc are then inside), so the joined path makes one more
+    pair and pays the cut's dual once more. Each half has paid its own pairs already; a path's
+    pairs per stretch of memory do not depend on the direction it is counted in.
     """
     n = cost.shape[0]
     W = fmask.shape[1]
@@ -501,12 +510,18 @@ def _join(fnode, fen, fpr, fmask, falive, bnode, ben, bpr, bmask, bstart, border
                         break
                 if not ok:
                     continue
+                pair = fpr[f] + bpr[b]
+                both = fsr[f] & bsr[b]
+                if both:
+                    pair -= _sigsum(both, sig)
+                    if pair <= threshold:
+                        continue
                 if k < max_pairs:
                     pf[k] = f
                     pb[k] = b
-                    val[k] = fpr[f] + bpr[b]
+                    val[k] = pair
                     k += 1
-                threshold = fpr[f] + bpr[b]
+                threshold = pair
     return pf[:k], pb[:k], val[:k], threshold
 
 
@@ -705,7 +720,7 @@ def _label_table(cost, profit, budget, ng, allowed, threshold, max_labels, deadl
     order, cin, reach, lastord, cend = _prepare(cost, ret, profit, allowed)
     if cuts is None:
         cuts = (np.zeros(n, np.uint64), np.zeros(n, np.uint64), np.zeros((8, 256)))
-    count, node, pred, en, pr, _, _, hit, _ = _label(
+    count, node, pred, en, pr, _, _, hit, _, _ = _label(
         cost, ret, profit, budget, ng, allowed, False, max_labels, order, cin, reach, lastord,
         cend, float(threshold), float(deadline), float(budget), *cuts,
         *suffix_tables(cost, profit, allowed, budget), 1.0,
@@ -792,7 +807,7 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     Subset-row cuts: ``cut_members[w]`` is the bitset of the (at most 64) cuts whose triple holds
     point w, ``cut_memory[w]`` of those whose memory holds it (None: every cut remembers every
     point), ``cut_duals`` their duals; a path's prize is then its reduced prize with the cuts'
-    duals paid. The join does not track cuts, so with cuts the search is one-way.
+    duals paid, in either direction (:func:`_join` pays the pairs a join makes).
 
     ``keep`` (exact mode): how far below the best path found the pruning threshold stays, as a
     share of the best's gain over ``min_gain`` (:func:`_label`); 0 finds the best value with the
@@ -816,11 +831,10 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
         mmem = (np.full(n, np.uint64(0xFFFFFFFFFFFFFFFF), dtype=np.uint64) if cut_memory is None
                 else np.ascontiguousarray(cut_memory, dtype=np.uint64))
         sig = _byte_sums(np.where(duals > 0, duals, 0.0))
-        bidirectional = False
     end = n - 1
     half = budget / 2.0 if bidirectional else budget
     order, cin, reach, lastord, cend = _prepare(cost, ret, profit, allowed)
-    count, node, pred, en, pr, fmask, falive, hit, thr = _label(
+    count, node, pred, en, pr, fmask, falive, hit, thr, fsr = _label(
         cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
         lastord, cend, float(min_gain), float(deadline), half, cmem, mmem, sig,
         *suffix_tables(cost, profit, allowed, budget), float(keep),
@@ -836,7 +850,7 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
         perm, cost_b, profit_b, allowed_b = _reversed(cost, profit, allowed)
         ret_b = cheapest_return(cost_b)
         order_b, cin_b, reach_b, lastord_b, cend_b = _prepare(cost_b, ret_b, profit_b, allowed_b)
-        bcount, bnode, bpred, ben, bpr, bmask, balive, bhit, thr = _label(
+        bcount, bnode, bpred, ben, bpr, bmask, balive, bhit, thr, bsr = _label(
             cost_b, ret_b, profit_b, budget, ng, allowed_b, heuristic, max_labels, order_b, cin_b,
             reach_b, lastord_b, cend_b, float(thr), float(deadline), half, cmem[perm], mmem[perm], sig,
             *suffix_tables(cost_b, profit_b, allowed_b, budget), float(keep),
@@ -854,8 +868,9 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
         keep = np.flatnonzero(balive)
         keep = keep[np.lexsort((-bpr[keep], point[keep]))]
         bstart = np.searchsorted(point[keep], np.arange(n + 1)).astype(np.int64)
-        pf, pb, val, thr = _join(node, en, pr, fmask, falive, bnode, ben, bpr, bmask, bstart,
-                                 keep.astype(np.int64), cost, budget, half, float(thr), 4 * n_cols)
+        pf, pb, val, thr = _join(node, en, pr, fmask, falive, fsr, bnode, ben, bpr, bmask, bsr,
+                                 bstart, keep.astype(np.int64), cost, budget, half, float(thr),
+                                 4 * n_cols, sig)
         if val.size:
             best = max(best, float(val.max()))
         for f, b, v in zip(pf, pb, val):
