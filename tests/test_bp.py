@@ -975,6 +975,9 @@ def test_solve_bp_options_override_a_default():
     forced = solve_bp(inst, time_limit=30,
                       options=BPOptions(cut_rounds=4, cut_gap=100.0, cut_share=1.0))
     assert default.info["cuts"] == 0 and forced.info["cuts"] > 0
+    # each run's info holds the settings it used, the limit's defaults filled in
+    assert default.info["options"]["cut_rounds"] == 0 and forced.info["options"]["cut_rounds"] == 4
+    assert forced.info["options"]["cut_share"] == 1.0 and "exact_keep" in default.info["options"]
     for r in (default, forced):
         assert r.status == Status.OPTIMAL and r.bound == pytest.approx(OPTIMAL["p2.2.k"])
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import asdict
 
 from sarcover.formulations.bp.options import BPOptions
 from sarcover.formulations.bp.pricing import warm_up
@@ -37,6 +38,7 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
     proven, bound = bp.run()
     info = bp.search.stats.info(columns=bp.search.master.n_routes,
                                 bidirectional=bp.pricer.bidirectional)
+    info["options"] = asdict(bp.options)  # the settings this run used, so stored rows say so
     return _result(bp, proven, bound, info, t0)
 
 
