@@ -37,8 +37,7 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
                         options=options)
     proven, bound = bp.run()
     info = bp.search.stats.info(columns=bp.search.master.n_routes,
-                                bidirectional=bp.pricer.bidirectional)
-    info["options"] = asdict(bp.options)  # the settings this run used, so stored rows say so
+                                bidirectional=bp.pricer.bidirectional, options=asdict(bp.options))
     return _result(bp, proven, bound, info, t0)
 
 

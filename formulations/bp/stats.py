@@ -48,9 +48,10 @@ class Stats:
     mode_times: tuple | None = None  # first exact pricing: (one-way s, bidirectional s)
     history: list = field(default_factory=list)  # (time, incumbent, bound)
 
-    def info(self, *, columns: int, bidirectional: bool | None) -> dict:
+    def info(self, *, columns: int, bidirectional: bool | None, options: dict) -> dict:
         """The run's ``Result.info``: these counters (times rounded to ms), the master's number
-        of ``columns`` and the exact pricing direction that was kept."""
+        of ``columns``, the exact pricing direction that was kept and the run's ``options`` (its
+        :class:`.options.BPOptions` as a dict, so that stored rows say which settings made them)."""
         return {
             "nodes": self.nodes, "rounds": self.rounds, "columns": columns,
             "exact_pricings": self.exact_pricings, "labels": self.labels,
@@ -71,4 +72,5 @@ class Stats:
             "pricing_s": round(self.pricing_s, 3), "lp_s": round(self.lp_s, 3),
             "root_bound": self.root_bound, "root_s": self.root_s, "history": self.history,
             "threads": 1, "bidirectional": bidirectional, "mode_times": self.mode_times,
+            "options": options,
         }
