@@ -32,10 +32,13 @@ once-per-node knapsack bounds it), which is all the master's bound needs.
 
 Search order and data layout: labels are extended in order of energy (a binary heap), so a label
 is only extended once every label of lower energy exists: it is never dominated after its
-extensions were made (far fewer labels than FIFO order). For the dominance
-tests the alive labels of each point sit in a contiguous bucket (energy, prize, remembered set,
-id); a label that dominates a candidate moves halfway to the bucket's front, where the next
-candidates meet it first. Paths are kept in creation order.
+extensions were made (far fewer labels than FIFO order). For the dominance tests the alive labels
+of each point sit in energy sub-buckets (``NSUB`` equal slices of the budget), each a contiguous
+array (energy, prize, remembered set, cut parities, id) sorted by prize, best first. A candidate
+can only be dominated by a label of no more energy and no less prize: the heads of the
+sub-buckets up to its energy, down to its prize; it can only dominate the tails of the
+sub-buckets from its energy on. Most labels of a point fail one of the two scalar tests, and
+this layout never visits them. Paths are kept in creation order.
 
 Bidirectional mode (exact only): the same routine runs forward from the start and backward from
 the end (on the reversed graph), extending labels only up to half the budget, and the halves are
@@ -245,10 +248,29 @@ def _byte_sums(duals: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(d.reshape(8, 8) @ bits.T)
 
 
+NSUB = 32  # energy sub-buckets per point (fewer on large graphs: at most 16384 in all)
+
+
+def sub_buckets(n_points: int) -> int:
+    """Energy sub-buckets per point of the labelling's dominance layout on ``n_points``."""
+    return max(1, min(NSUB, 16384 // n_points))
+
+
+@njit(cache=True)
+def _sub(e, budget, S):
+    """Energy sub-bucket (of ``S`` equal slices of the budget) of a label of energy ``e``."""
+    k = int(e * S / budget) if budget > 0 else 0
+    if k < 0:
+        return 0
+    if k >= S:
+        return S - 1
+    return k
+
+
 @njit(cache=True)
 def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
            lastord, cend, threshold, deadline, half, cmem, mmem, sig, g1, s1, g2, delta, nb,
-           keep):
+           keep, nsub):
     """Labelling from node 0 to node n-1.
 
     Returns (count, node, pred, energy, prize, mask, alive, hit_cap, threshold, cut parities).
@@ -259,8 +281,8 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
     that share of the best's gain over the start (more columns per call, more labels), 1 never
     raises it; only labels with energy <= ``half`` are extended (``half`` = budget for a one-way
     search). Labels are kept in creation order (global arrays, for the paths) and, for the
-    dominance tests, in contiguous per-node buckets (energy, prize, mask, label id) so that the
-    scans stay in cache.
+    dominance tests, in ``nsub`` contiguous sub-buckets per point by energy (energy, prize, mask,
+    cut parities, label id), each sorted by prize, best first (see the module docstring).
 
     Limited-memory subset-row cuts (``cmem[w]``: bitset of the cuts whose triple holds w;
     ``mmem[w]``: of the cuts whose memory holds w, a superset; ``sig``: their duals, >= 0): a
@@ -281,13 +303,15 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
     alive = np.empty(cap, np.bool_)
     mask = np.zeros((cap, W), np.uint64)
     srb = np.zeros(cap, np.uint64)
-    # per-node buckets of the alive labels
-    bcnt = np.zeros(n, np.int64)
-    ben = [np.empty(16, np.float64) for _ in range(n)]
-    bpr = [np.empty(16, np.float64) for _ in range(n)]
-    bid = [np.empty(16, np.int32) for _ in range(n)]
-    bmask = [np.zeros((16, W), np.uint64) for _ in range(n)]
-    bsr = [np.zeros(16, np.uint64) for _ in range(n)]
+    # the alive labels of each point w, in its sub-buckets w*S .. w*S+S-1 (by energy), each
+    # sorted by prize, best first
+    S = nsub
+    bcnt = np.zeros(n * S, np.int64)
+    ben = [np.empty(0, np.float64) for _ in range(n * S)]
+    bpr = [np.empty(0, np.float64) for _ in range(n * S)]
+    bid = [np.empty(0, np.int32) for _ in range(n * S)]
+    bmask = [np.zeros((0, W), np.uint64) for _ in range(n * S)]
+    bsr = [np.zeros(0, np.uint64) for _ in range(n * S)]
     node[0] = 0
     pred[0] = -1
     en[0] = 0.0
@@ -344,67 +368,78 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             if p2 + _completion(newmask, w, budget - e2, threshold - p2, order, profit, cin, reach,
                                 lastord, cend) <= threshold:
                 continue
-            # dominance against the labels at w
+            # dominance against the labels at w (sub-buckets by energy, each best prize first):
+            # a dominator has energy <= e2 and prize >= p2, so it is in the head of a sub-bucket
+            # up to e2's (nearest first); a label the new one dominates has energy >= e2 and
+            # prize <= p2: the tail of a sub-bucket from e2's on
             dominated = False
-            we = ben[w]
-            wp = bpr[w]
-            wi = bid[w]
-            wm = bmask[w]
-            ws = bsr[w]
-            cw = bcnt[w]
-            j = 0
-            while j < cw:
-                ej = we[j]
-                pj = wp[j]
-                if ej <= e2 + EPS and pj >= p2 - EPS:
-                    sub = True
-                    if not heuristic:
-                        for k in range(W):
-                            if wm[j, k] & ~newmask[k]:
-                                sub = False
-                                break
-                    if sub:
-                        odd = ws[j] & ~s2
-                        if odd and pj - _sigsum(odd, sig) < p2 - EPS:
-                            sub = False
-                    if sub:
-                        dominated = True
-                        if j > 0:  # move the dominator forward: it is likely to dominate again
-                            h = j >> 1
-                            we[j], we[h] = we[h], we[j]
-                            wp[j], wp[h] = wp[h], wp[j]
-                            wi[j], wi[h] = wi[h], wi[j]
-                            ws[j], ws[h] = ws[h], ws[j]
+            shi = _sub(e2 + EPS, budget, S)
+            slo = _sub(e2 - EPS, budget, S)
+            for sx in range(shi, -1, -1):
+                bx = w * S + sx
+                cw = bcnt[bx]
+                if cw == 0:
+                    continue
+                we = ben[bx]
+                wp = bpr[bx]
+                wm = bmask[bx]
+                ws = bsr[bx]
+                j = 0
+                while j < cw and wp[j] >= p2 - EPS:
+                    if we[j] <= e2 + EPS:
+                        sub = True
+                        if not heuristic:
                             for k in range(W):
-                                t = wm[j, k]
-                                wm[j, k] = wm[h, k]
-                                wm[h, k] = t
-                        break
-                if e2 <= ej + EPS and p2 >= pj - EPS:
-                    sub = True
-                    if not heuristic:
-                        for k in range(W):
-                            if newmask[k] & ~wm[j, k]:
+                                if wm[j, k] & ~newmask[k]:
+                                    sub = False
+                                    break
+                        if sub:
+                            odd = ws[j] & ~s2
+                            if odd and wp[j] - _sigsum(odd, sig) < p2 - EPS:
                                 sub = False
-                                break
-                    if sub:
-                        odd = s2 & ~ws[j]
-                        if odd and p2 - _sigsum(odd, sig) < pj - EPS:
-                            sub = False
-                    if sub:
-                        alive[wi[j]] = False
-                        cw -= 1  # move the bucket's last label into slot j, examine it next
-                        we[j] = we[cw]
-                        wp[j] = wp[cw]
-                        wi[j] = wi[cw]
-                        ws[j] = ws[cw]
-                        for k in range(W):
-                            wm[j, k] = wm[cw, k]
-                        continue
-                j += 1
-            bcnt[w] = cw
+                        if sub:
+                            dominated = True
+                            break
+                    j += 1
+                if dominated:
+                    break
             if dominated:
                 continue
+            for sx in range(slo, S):
+                bx = w * S + sx
+                cw = bcnt[bx]
+                if cw == 0:
+                    continue
+                we = ben[bx]
+                wp = bpr[bx]
+                wi = bid[bx]
+                wm = bmask[bx]
+                ws = bsr[bx]
+                j = cw - 1
+                while j >= 0 and wp[j] <= p2 + EPS:
+                    if e2 <= we[j] + EPS:
+                        sub = True
+                        if not heuristic:
+                            for k in range(W):
+                                if newmask[k] & ~wm[j, k]:
+                                    sub = False
+                                    break
+                        if sub:
+                            odd = s2 & ~ws[j]
+                            if odd and p2 - _sigsum(odd, sig) < wp[j] - EPS:
+                                sub = False
+                        if sub:
+                            alive[wi[j]] = False
+                            cw -= 1  # close the gap, keeping the order
+                            for i in range(j, cw):
+                                we[i] = we[i + 1]
+                                wp[i] = wp[i + 1]
+                                wi[i] = wi[i + 1]
+                                ws[i] = ws[i + 1]
+                                for k in range(W):
+                                    wm[i, k] = wm[i + 1, k]
+                    j -= 1
+                bcnt[bx] = cw
             if count == max_labels:
                 hit = True
                 break
@@ -438,25 +473,36 @@ def _label(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order,
             srb[count] = s2
             for k in range(W):
                 mask[count, k] = newmask[k]
-            if cw == we.shape[0]:
-                size = 2 * cw
-                we = _grow(we, size)
-                wp = _grow(wp, size)
-                wi = _grow(wi, size)
-                wm = _grow(wm, size)
-                ws = _grow(ws, size)
-                bsr[w] = ws
-                ben[w] = we
-                bpr[w] = wp
-                bid[w] = wi
-                bmask[w] = wm
-            we[cw] = e2
-            wp[cw] = p2
-            wi[cw] = count
-            ws[cw] = s2
+            bx = w * S + _sub(e2, budget, S)
+            cw = bcnt[bx]
+            if cw == ben[bx].shape[0]:
+                size = max(2 * cw, 8)
+                bsr[bx] = _grow(bsr[bx], size)
+                ben[bx] = _grow(ben[bx], size)
+                bpr[bx] = _grow(bpr[bx], size)
+                bid[bx] = _grow(bid[bx], size)
+                bmask[bx] = _grow(bmask[bx], size)
+            we = ben[bx]
+            wp = bpr[bx]
+            wi = bid[bx]
+            wm = bmask[bx]
+            ws = bsr[bx]
+            j = cw  # keep the sub-bucket sorted by prize, best first
+            while j > 0 and wp[j - 1] < p2:
+                we[j] = we[j - 1]
+                wp[j] = wp[j - 1]
+                wi[j] = wi[j - 1]
+                ws[j] = ws[j - 1]
+                for k in range(W):
+                    wm[j, k] = wm[j - 1, k]
+                j -= 1
+            we[j] = e2
+            wp[j] = p2
+            wi[j] = count
+            ws[j] = s2
             for k in range(W):
-                wm[cw, k] = newmask[k]
-            bcnt[w] = cw + 1
+                wm[j, k] = newmask[k]
+            bcnt[bx] = cw + 1
             hn = _heap_push(hkey, hval, hn, e2, count)
             count += 1
         if hit:
@@ -723,7 +769,7 @@ def _label_table(cost, profit, budget, ng, allowed, threshold, max_labels, deadl
     count, node, pred, en, pr, _, _, hit, _, _ = _label(
         cost, ret, profit, budget, ng, allowed, False, max_labels, order, cin, reach, lastord,
         cend, float(threshold), float(deadline), float(budget), *cuts,
-        *suffix_tables(cost, profit, allowed, budget), 1.0,
+        *suffix_tables(cost, profit, allowed, budget), 1.0, sub_buckets(n),
     )
     if hit:
         return None
@@ -790,7 +836,7 @@ def _chain(node, pred, j):
 
 def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_cols, min_gain,
           deadline=np.inf, bidirectional=False, cut_members=None, cut_memory=None, cut_duals=None,
-          keep=0.0):
+          keep=0.0, nsub=None):
     """Run the labelling; return a :class:`PricingResult`.
 
     ``profit`` holds the reduced prize of every point (0 at start and end); the value reported is
@@ -814,8 +860,12 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     fewest labels, more returns more of the near-best routes. The best value is exact either way.
     A bidirectional search's backward half starts from the forward half's final threshold, so its
     share is measured from there.
+
+    ``nsub``: energy sub-buckets per point for the dominance tests (None: :func:`sub_buckets`);
+    it changes only how fast the labels are found, not which.
     """
     n = cost.shape[0]
+    nsub = sub_buckets(n) if nsub is None else max(1, int(nsub))
     if cut_members is None or cut_duals is None or not np.any(cut_duals > 0):
         cmem = np.zeros(n, np.uint64)
         mmem = np.zeros(n, np.uint64)
@@ -837,7 +887,7 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     count, node, pred, en, pr, fmask, falive, hit, thr, fsr = _label(
         cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
         lastord, cend, float(min_gain), float(deadline), half, cmem, mmem, sig,
-        *suffix_tables(cost, profit, allowed, budget), float(keep),
+        *suffix_tables(cost, profit, allowed, budget), float(keep), nsub,
     )
     total = int(count)
     found = []  # (value, path)
@@ -853,7 +903,7 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
         bcount, bnode, bpred, ben, bpr, bmask, balive, bhit, thr, bsr = _label(
             cost_b, ret_b, profit_b, budget, ng, allowed_b, heuristic, max_labels, order_b, cin_b,
             reach_b, lastord_b, cend_b, float(thr), float(deadline), half, cmem[perm], mmem[perm], sig,
-            *suffix_tables(cost_b, profit_b, allowed_b, budget), float(keep),
+            *suffix_tables(cost_b, profit_b, allowed_b, budget), float(keep), nsub,
         )
         total += int(bcount)
         hit = hit or bhit
