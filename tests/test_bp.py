@@ -907,6 +907,36 @@ def test_purging_cuts_keeps_the_published_optimum():
     assert r.bound == pytest.approx(OPTIMAL["p2.2.k"])
 
 
+def test_cut_round_starts_only_if_it_would_end_within_the_share():
+    """A round of cuts is started only if, taking ROUND_GROWTH times as long as the round before
+    it, it would end within the cut share: with 30 s of the share left, a round after one of 1 s
+    goes on (to the labelling arc bounds that come first), a round after one of 20 s does not."""
+    from types import SimpleNamespace
+
+    from sarcover.formulations.bp.cuts import ROUND_GROWTH, CutRounds
+
+    class Reached(Exception):
+        """The round went past the gate (to the arc elimination before its first cuts)."""
+
+    search = SimpleNamespace(incumbent=object(), incumbent_value=10.0, step=1.0,
+                             master=SimpleNamespace(n_routes=0),
+                             stats=SimpleNamespace(root_lp=None), time_left=lambda: 100.0,
+                             floor=math.floor)
+    elimination = SimpleNamespace(version=0, eliminate=lambda labels: (_ for _ in ()).throw(Reached()))
+    state = SimpleNamespace(depth=0)
+
+    def gate(last_round_s: float):
+        now = time.perf_counter()
+        cuts = CutRounds(search, elimination, rounds=6, per_round=16, gap=1.0, until=now + 30.0)
+        cuts.started = now - last_round_s
+        return cuts.add(state, None, None, 10.5)
+
+    assert ROUND_GROWTH * 20.0 > 30.0 > ROUND_GROWTH * 1.0
+    with pytest.raises(Reached):
+        gate(1.0)
+    assert gate(20.0) is False
+
+
 @pytest.mark.parametrize("name", ["p1.3.n", "p3.2.k", "p2.2.k"])
 def test_cuts_keep_the_published_optimum(name):
     """With subset-row cuts forced on (these files get 8 to 38 cuts at the root), bp still proves
