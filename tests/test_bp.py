@@ -811,7 +811,8 @@ def test_dominance_layout_changes_speed_not_labels(seed):
     only where a dominator or a dominated label can be. On a paper-size graph (M = 20, K = 3)
     with random duals, ng sets and subset-row cuts, one plain bucket per point (nsub = 1) and
     the sub-buckets (default, and an odd count) create exactly the same labels: the same count,
-    best value and routes, one-way and bidirectional, exact and heuristic."""
+    best value and routes, one-way and bidirectional, exact and heuristic; the most sub-buckets a
+    label count may choose too."""
     from sarcover.formulations.generate import generate
     from sarcover.formulations.instance import to_top
     from sarcover.formulations.bp.pricing import cheapest_return, nearest_ng, price, sub_buckets
@@ -831,13 +832,56 @@ def test_dominance_layout_changes_speed_not_labels(seed):
                       heuristic=heuristic, bidirectional=bidirectional, max_labels=2_000_000,
                       n_cols=60, min_gain=1.0, cut_members=members, cut_memory=memory,
                       cut_duals=sig, keep=0.0 if heuristic else 0.5, nsub=nsub)
-                for nsub in (1, None, 7)]
+                for nsub in (1, None, 7, 256)]
         assert runs[0].n_labels > 1000
         assert runs[0].exact == (not heuristic)
         for r in runs[1:]:
             assert r.n_labels == runs[0].n_labels
             assert r.best == runs[0].best
             assert r.routes == runs[0].routes and r.ng_routes == runs[0].ng_routes
+
+
+def test_sub_buckets_follow_the_expected_labels_per_point():
+    """Without a label count the layout has NSUB sub-buckets per point; with one, about
+    1.5·sqrt(labels per point) as a power of two within NSUB_RANGE, growing with the count, and
+    never more than SUB_CELLS in all."""
+    from sarcover.formulations.bp.pricing import NSUB, NSUB_RANGE, SUB_CELLS, sub_buckets
+
+    assert sub_buckets(62) == NSUB and sub_buckets(62, 0) == NSUB
+    counts = [sub_buckets(62, labels) for labels in (100, 20_000, 100_000, 300_000, 10**8)]
+    assert counts == sorted(counts)
+    assert counts[0] == NSUB_RANGE[0] and counts[-1] == NSUB_RANGE[1]
+    assert sub_buckets(62, 100_000) == 64 and sub_buckets(62, 300_000) == 128
+    assert sub_buckets(102, 10**8) * 102 <= SUB_CELLS
+    assert sub_buckets(5000, 10**8) == SUB_CELLS // 5000
+
+
+def test_exact_pricing_is_laid_out_for_the_previous_exact_calls_labels(monkeypatch):
+    """The search's exact calls pass the dominance layout sized by the previous exact call's
+    label count (the first call, and every heuristic one, the default)."""
+    import sarcover.formulations.bp.pricer as pricer_mod
+    from sarcover.formulations.bp.pricing import sub_buckets
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
+    from sarcover.formulations.result import Termination
+
+    seen = []
+    real = pricer_mod.price
+
+    def spy(*args, **kw):
+        res = real(*args, **kw)
+        seen.append((kw["heuristic"], kw["nsub"], res.n_labels, args[0].shape[0]))
+        return res
+
+    monkeypatch.setattr(pricer_mod, "price", spy)
+    res = solve_bp(to_top(generate(8, 3, 2, 3)), time_limit=20)
+    assert res.termination == Termination.OPTIMAL
+    exact = [(nsub, labels, n) for heuristic, nsub, labels, n in seen if not heuristic]
+    assert len(exact) >= 2
+    assert all(nsub is None for heuristic, nsub, _, _ in seen if heuristic)
+    assert exact[0][0] == sub_buckets(exact[0][2])
+    for (_, before, _), (nsub, _, n) in zip(exact, exact[1:]):
+        assert nsub == sub_buckets(n, before)
 
 
 def test_master_cut_rows_hold_lm_coefficients():

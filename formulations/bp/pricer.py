@@ -7,7 +7,7 @@ from __future__ import annotations
 import time
 from typing import TYPE_CHECKING
 
-from sarcover.formulations.bp.pricing import price
+from sarcover.formulations.bp.pricing import price, sub_buckets
 from sarcover.formulations.bp.search import TOL
 
 if TYPE_CHECKING:
@@ -25,6 +25,7 @@ class Pricer:
         self.bidirectional = bidirectional
         self.ng_columns = ng_columns
         self.keep = keep
+        self.last_exact_labels = None  # sizes the next exact call's dominance layout
 
     def price(self, cost, ret, prof, allowed, *, heuristic: bool, y0: float, sig,
               deadline: float | None = None):
@@ -33,14 +34,18 @@ class Pricer:
         more for a targeted exact call); ``sig``: the subset-row cuts' duals."""
         s = self.search
         t = time.perf_counter()
+        # an exact call makes about as many labels as the one before it: its sub-buckets follow
+        nsub = None if heuristic else sub_buckets(cost.shape[0], self.last_exact_labels)
         res = price(cost, ret, prof, s.budget, s.ng, allowed, heuristic=heuristic,
                     max_labels=200_000 if heuristic else 2_000_000,
                     n_cols=30 if heuristic else 60, min_gain=y0 + TOL,
                     deadline=s.deadline if deadline is None else deadline,
                     bidirectional=bool(self.bidirectional) and not heuristic,
                     cut_members=s.master.cut_members, cut_memory=s.master.cut_memory,
-                    cut_duals=sig, keep=0.0 if heuristic else self.keep)
+                    cut_duals=sig, keep=0.0 if heuristic else self.keep, nsub=nsub)
         s.stats.pricing_s += time.perf_counter() - t
+        if not heuristic:
+            self.last_exact_labels = res.n_labels
         s.stats.labels += res.n_labels
         return res
 

@@ -53,6 +53,7 @@ its route is its path followed by the end. Sets are bitsets of ``W`` 64-bit word
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -249,12 +250,25 @@ def _byte_sums(duals: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(d.reshape(8, 8) @ bits.T)
 
 
-NSUB = 32  # energy sub-buckets per point (fewer on large graphs: at most 16384 in all)
+NSUB = 32  # energy sub-buckets per point when the call's size is unknown
+NSUB_RANGE = (16, 256)  # the sub-buckets per point a label count may choose
+SUB_CELLS = 16384  # at most this many sub-buckets in all (their arrays are allocated per call)
 
 
-def sub_buckets(n_points: int) -> int:
-    """Energy sub-buckets per point of the labelling's dominance layout on ``n_points``."""
-    return max(1, min(NSUB, 16384 // n_points))
+def sub_buckets(n_points: int, labels: int | None = None) -> int:
+    """Energy sub-buckets per point of the labelling's dominance layout on ``n_points``.
+
+    ``labels``: the labels the call is expected to make (the run's previous exact call), or None
+    for ``NSUB``. A dominance test visits every sub-bucket on its side of the candidate's energy
+    and the labels of the one its energy falls in whose prize passes, so the best count grows
+    with the labels per point: about 1.5·sqrt(labels per point), as a power of two within
+    ``NSUB_RANGE`` (replayed exact calls: 32 was best up to about 1 000 labels per point, 64
+    around 1 500, 128 from about 4 000)."""
+    s = NSUB
+    if labels:
+        s = 2 ** round(math.log2(1.5 * math.sqrt(labels / n_points)))
+        s = min(max(s, NSUB_RANGE[0]), NSUB_RANGE[1])
+    return max(1, min(s, SUB_CELLS // n_points))
 
 
 @njit(cache=True)
