@@ -33,8 +33,8 @@ once-per-node knapsack bounds it), which is all the master's bound needs.
 Search order and data layout: labels are extended in order of energy (a binary heap), so a label
 is only extended once every label of lower energy exists: it is never dominated after its
 extensions were made (far fewer labels than FIFO order). For the dominance tests the alive labels
-of each point sit in energy sub-buckets (:func:`sub_buckets`: ``NSUB`` equal slices of the
-budget, fewer on large graphs), each held in contiguous arrays (energy, prize, remembered set,
+of each point sit in energy sub-buckets (:func:`sub_buckets`: equal slices of the budget, more
+of them the more labels a call makes per point), each held in contiguous arrays (energy, prize, remembered set,
 cut parities, id) sorted by prize, best first. A candidate
 can only be dominated by a label of no more energy and no less prize: the heads of the
 sub-buckets up to its energy, down to its prize; it can only dominate the tails of the
