@@ -34,12 +34,12 @@ Search order and data layout: labels are extended in order of energy (a binary h
 is only extended once every label of lower energy exists: it is never dominated after its
 extensions were made (far fewer labels than FIFO order). For the dominance tests the alive labels
 of each point sit in energy sub-buckets (:func:`sub_buckets`: equal slices of the budget, more
-of them the more labels a call makes per point), each held in contiguous arrays (energy, prize, remembered set,
-cut parities, id) sorted by prize, best first. A candidate
-can only be dominated by a label of no more energy and no less prize: the heads of the
-sub-buckets up to its energy, down to its prize; it can only dominate the tails of the
-sub-buckets from its energy on. Most labels of a point fail one of the two scalar tests, and
-this layout never visits them. Paths are kept in creation order.
+of them the more labels a call makes per point), each held in contiguous arrays (energy, prize,
+remembered set, cut parities, id) sorted by prize, best first. A candidate can only be
+dominated by a label of no more energy and no less prize: the heads of the sub-buckets up to its
+energy, down to its prize; it can only dominate the tails of the sub-buckets from its energy on.
+Most labels of a point fail one of the two scalar tests, and this layout never visits them. Paths
+are kept in creation order.
 
 Bidirectional mode (exact only): the same routine runs forward from the start and backward from
 the end (on the reversed graph), extending labels only up to half the budget, and the halves are
