@@ -146,10 +146,11 @@ def cover_groups(instance: TOPInstance, routes, refill: bool = False) -> list[li
 
 
 def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: int, time_limit: float,
-           initial: list[list[int]] | None = None):
+           initial: list[list[int]] | None = None, iterations: int | None = ITERATIONS):
     """One PyVRP run; returns (routes as node ids or None if PyVRP found no feasible plan, info).
 
-    ``initial`` (node ids, without covers only) is PyVRP's warm start."""
+    ``initial`` (node ids, without covers only) is PyVRP's warm start; ``iterations``: the ILS
+    iterations at most (None: the time limit alone stops it)."""
     n_veh = instance.n_vehicles
     sc = scaled_costs(instance, RESOLUTION)
     end = instance.n_nodes + 1
@@ -194,7 +195,8 @@ def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: in
     if not instance.same_depot:
         m.add_edge(start_loc, end_loc, 0)  # an empty route costs nothing
         m.add_edge(end_loc, start_loc, big)
-    stop = MultipleCriteria([MaxIterations(ITERATIONS), MaxRuntime(max(time_limit, 0.01))])
+    runtime = MaxRuntime(max(time_limit, 0.01))
+    stop = runtime if iterations is None else MultipleCriteria([MaxIterations(iterations), runtime])
     t_solve = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:  # PenaltyBoundWarning on (near-)infeasible data
         warnings.simplefilter("always")
@@ -227,11 +229,13 @@ def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: in
     return routes, info
 
 
-def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0) -> Result:
+def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
+          iterations: int | None = ITERATIONS) -> Result:
     """Prize-collecting TOP by PyVRP (seeded, iteration-limited) plus group repair.
 
-    With groups, pass 1 uses cover copies; only if it yields no covering plan does pass 2
-    solve without them and repair coverage afterwards (see the module docstring).
+    With groups, pass 1 uses cover copies; pass 2 starts from pass 1's plan without them and
+    repairs coverage afterwards (see the module docstring). ``iterations``: each pass's ILS
+    iterations at most (None: only the time limit, at most ``TIME_CAP``, stops the passes).
     """
     t0 = time.perf_counter()
     cap = min(TIME_CAP if time_limit is None else float(time_limit), TIME_CAP)
@@ -245,7 +249,7 @@ def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60
         return Result("pyvrp", Termination.COMPLETED, plan=Plan.of([[] for _ in range(instance.n_vehicles)]),
                       runtime_s=time.perf_counter() - t0, info={**info, "stopped_by": "trivial"})
     if not instance.groups:
-        routes, run_info = _solve(instance, nodes, False, seed, cap)
+        routes, run_info = _solve(instance, nodes, False, seed, cap, iterations=iterations)
         info.update(run_info)
         if routes is None:
             return Result("pyvrp", Termination.COMPLETED, reason="PyVRP found no plan within the budget",
@@ -257,14 +261,15 @@ def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60
     # pass 1: cover copies, so PyVRP itself covers every group; then dedupe and refill
     reason = "PyVRP found no plan within the budget"
     best_routes = None
-    routes, run_info = _solve(instance, nodes, True, seed, PASS1_SHARE * cap)
+    routes, run_info = _solve(instance, nodes, True, seed, PASS1_SHARE * cap, iterations=iterations)
     info["pass1"] = run_info
     if routes is not None:
         best_routes = cover_groups(instance, routes, refill=bool(run_info["duplicates_dropped"]))
     # pass 2: no covers (no duplicate distortion), warm-started from pass 1; repair coverage after
     remaining = cap - (time.perf_counter() - t0)
     if remaining > 0.05:
-        routes, run_info = _solve(instance, nodes, False, seed, remaining, initial=best_routes)
+        routes, run_info = _solve(instance, nodes, False, seed, remaining, initial=best_routes,
+                                  iterations=iterations)
         info["pass2"] = run_info
         if routes is not None:
             repaired = cover_groups(instance, routes)
@@ -281,11 +286,19 @@ def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60
 
 
 def primal_routes(instance: TOPInstance, seed: int):
-    """A primal heuristic for bp: ``run(seconds)`` returns PyVRP's routes (node ids) within that
-    time, or None without a plan."""
+    """A primal heuristic for bp: ``run(seconds)`` returns PyVRP's routes (node ids) found within
+    that time, or None without a plan. The first call is the registered method (``seed``,
+    ``ITERATIONS`` per pass: a good plan in a few seconds); each later call searches with a new
+    seed until its time is up, since on M = 20, K = 3 PyVRP still finds better plans after 2000
+    iterations and another seed finds others (docs/bp.md)."""
+    calls = 0
 
     def run(seconds: float):
-        res = pyvrp(instance, seed=seed, time_limit=max(seconds, 0.05))
+        nonlocal calls
+        more = calls > 0
+        calls += 1
+        res = pyvrp(instance, seed=seed + calls - 1, time_limit=max(seconds, 0.05),
+                    iterations=None if more else ITERATIONS)
         return None if res.plan is None else [list(r) for r in res.plan.routes]
 
     return run

@@ -562,6 +562,24 @@ def test_primal_plan_becomes_the_incumbent_when_the_root_needs_it():
     assert r.info["primal_s"] is not None and r.info["primal_error"] is None
 
 
+def test_primal_runs_again_after_the_root_when_the_proof_stays_open():
+    """On an instance whose root bound stays above every plan (M = 12, K = 3, N = 3, seed 0,
+    no cuts), the heuristic runs after the first dive and once more after the root's last
+    dive, never more; the run still proves its plan optimal."""
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
+
+    inst = to_top(generate(12, 3, 3, 0))
+    calls = []
+    r = solve_bp(inst, time_limit=60, primal=lambda seconds: calls.append(seconds),
+                 options=BPOptions(cut_rounds=0))
+    rep = verify(inst, r.plan)
+    assert r.status == Status.OPTIMAL and rep.valid
+    assert math.floor(r.info["root_bound"] + 1e-6) > rep.prize  # the root left it open
+    assert len(calls) == 2 == r.info["primal_calls"]
+    assert all(0 < c <= 0.1 * 60 + 1e-9 for c in calls)
+
+
 def test_primal_is_not_run_when_the_root_proves():
     calls = []
     inst = _top("p1.2.a")

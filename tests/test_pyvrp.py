@@ -1,5 +1,7 @@
 """`pyvrp` specifics: reproducibility, the group repair, and the integer scaling guarantee."""
 
+import time
+
 import numpy as np
 import pytest
 
@@ -10,7 +12,7 @@ from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Status
 from sarcover.formulations.scaling import integer_prizes, scaled_costs
 from sarcover.formulations.verify import route_energy, verify
-from sarcover.heuristics.pyvrp_ils import cover_groups
+from sarcover.heuristics.pyvrp_ils import cover_groups, primal_routes, pyvrp
 
 
 @pytest.mark.parametrize("seed", [0, 7])
@@ -21,6 +23,31 @@ def test_same_seed_same_plan(seed):
     b = run_method("pyvrp", inst, seed=seed, time_limit=30.0)
     assert all(a.info[p]["stopped_by"] == "iterations" for p in ("pass1", "pass2"))
     assert a.status == Status.FEASIBLE and a.plan == b.plan
+
+
+def test_without_an_iteration_limit_the_time_limit_stops_both_passes():
+    """iterations=None (bp's primal heuristic): PyVRP searches until its time is up, past the
+    iterations that stop the registered method; the plan still covers every target."""
+    inst = to_top(generate(8, 2, 2, 0, e_max=6000.0))
+    res = pyvrp(inst, seed=0, time_limit=1.0, iterations=None)
+    assert all(res.info[p]["stopped_by"] == "time" for p in ("pass1", "pass2"))
+    rep = verify(inst, res.plan)
+    assert rep.valid and rep.groups_covered == len(inst.groups)
+
+
+def test_bps_primal_heuristic_is_the_method_first_then_searches_its_time():
+    """primal_routes' first call is the registered method (same seed, same iteration stop, same
+    plan); a second call searches with another seed until its seconds are up (a tiny instance
+    the method finishes in far less time keeps it busy) and returns a valid plan (node ids)."""
+    inst = to_top(generate(8, 2, 2, 0, e_max=6000.0))
+    method = pyvrp(inst, seed=3, time_limit=30.0)
+    assert method.info["pass1"]["stopped_by"] == "iterations"
+    run = primal_routes(inst, 3)
+    assert Plan.of(run(30.0)) == method.plan
+    t = time.perf_counter()
+    routes = run(1.0)
+    assert time.perf_counter() - t >= 0.9  # both passes ran until their share of the second
+    assert verify(inst, Plan.of(routes)).valid
 
 
 def test_cover_groups_repairs_an_uncovering_plan():

@@ -27,8 +27,8 @@ if TYPE_CHECKING:
 
 class IncumbentSearch:
     """Incumbents of one run. ``primal(seconds) -> routes or None`` (node ids): the caller's
-    heuristic, run at most once with ``primal_limit`` seconds; ``dive_limit``: seconds for a dive
-    at the root (later dives get less)."""
+    heuristic, run at most twice (at the root) with up to ``primal_limit`` seconds each;
+    ``dive_limit``: seconds for a dive at the root (later dives get less)."""
 
     def __init__(self, search: "Search", pricer: "Pricer", elimination: "Elimination", primal,
                  *, dive_limit: float, primal_limit: float):
@@ -39,6 +39,7 @@ class IncumbentSearch:
         self.dive_limit = dive_limit
         self.primal_limit = primal_limit
         self.dived = False  # the root's first dive has run
+        self.primal_calls = 0
         self.dive_starts: set[int] = set()  # first route fixed by each dive so far
 
     def offer(self, routes):
@@ -82,14 +83,18 @@ class IncumbentSearch:
             s.stats.milp_s += time.perf_counter() - t
             s.stats.milp_improved += s.incumbent_value > before
 
-    def call_primal(self) -> None:
-        """Run the caller's heuristic (``primal``) once: its plan becomes columns and, if the
-        verifier passes it and it is better, the incumbent. Called when the root's floored bound
-        is settled and the first dive has not found a plan that proves it, so instances the root
-        or its first dive settle (most TOP instances) never pay for it."""
+    def call_primal(self) -> bool:
+        """Run the caller's heuristic (``primal``): its plan becomes columns and, if the verifier
+        passes it and it is better, the incumbent; reports whether it ran. Called when the
+        root's floored bound is settled and the first dive has not found a plan that proves it,
+        so instances the root or its first dive settle (most TOP instances) never pay for it;
+        and once more after the root's cut rounds and last dive if the proof is still open (a
+        heuristic may return another plan when called again: the registered bp's PyVRP then
+        searches with a new seed until its time is up)."""
         s = self.search
         if self.primal is None or s.time_left() <= 0:
-            return
+            return False
+        self.primal_calls += 1
         t = time.perf_counter()
         allowance = min(self.primal_limit, 0.5 * s.time_left())
         try:
@@ -97,15 +102,18 @@ class IncumbentSearch:
         except Exception as exc:  # a failing heuristic must not cost the proof search
             s.stats.primal_error = f"{type(exc).__name__}: {exc}"
             routes = None
-        s.stats.primal_s = round(time.perf_counter() - t, 3)
+        s.stats.primal_s = round((s.stats.primal_s or 0.0) + time.perf_counter() - t, 3)
+        s.stats.primal_calls = self.primal_calls
         if not routes:
-            return
+            return True
         pts = [tuple(int(v) + 1 for v in r) for r in routes if len(r)]
         before = s.incumbent_value
         rep = self.offer(pts)
-        s.stats.primal_prize = float(rep.prize) if rep is not None and rep.valid else None
-        s.stats.primal_improved = s.incumbent_value > before
+        if rep is not None and rep.valid:
+            s.stats.primal_prize = max(float(rep.prize), s.stats.primal_prize or -np.inf)
+        s.stats.primal_improved = bool(s.stats.primal_improved) or s.incumbent_value > before
         s.master.add_routes([r for r in pts if s.energy(r) <= s.budget])
+        return True
 
     def dive(self, limit: float, start: NodeState | None = None, *, fresh: bool = False) -> None:
         """Diving: fix the route of largest LP value (its nodes and arcs forced), re-solve the

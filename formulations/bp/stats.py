@@ -24,7 +24,8 @@ class Stats:
     milp_columns: int | None = None  # routes the last MILP could use (reduced-cost filter)
     dives: int = 0
     dive_improved: int = 0  # dives that raised the incumbent
-    primal_s: float | None = None  # the caller's heuristic: time, its plan's prize, improved?
+    primal_calls: int = 0  # the caller's heuristic: calls, their time, best plan's prize, improved?
+    primal_s: float | None = None
     primal_prize: float | None = None
     primal_improved: bool | None = None
     primal_error: str | None = None
@@ -67,7 +68,8 @@ class Stats:
             "enum_tries": self.enum_tries, "enum_labels": self.enum_labels,
             "enum_routes": self.enum_routes, "enum_s": round(self.enum_s, 3),
             "enum_milp_s": round(self.enum_milp_s, 3), "enum_status": self.enum_status,
-            "root_lp": self.root_lp, "primal_s": self.primal_s, "primal_prize": self.primal_prize,
+            "root_lp": self.root_lp, "primal_calls": self.primal_calls,
+            "primal_s": self.primal_s, "primal_prize": self.primal_prize,
             "primal_improved": self.primal_improved, "primal_error": self.primal_error,
             "pricing_s": round(self.pricing_s, 3), "lp_s": round(self.lp_s, 3),
             "root_bound": self.root_bound, "root_s": self.root_s, "history": self.history,

@@ -86,7 +86,8 @@ class BranchAndPrice:
         """The root's column generation, then, once its LP is solved: tighter arc bounds by
         labelling (and the root again on the smaller graph if they remove arcs: its bound may
         now prove the plan) and a dive from the final root LP (the first dive ran before the ng
-        sets grew). Returns what :meth:`.colgen.ColumnGeneration.solve` does."""
+        sets grew), then the caller's heuristic once more if the proof is still open. Returns
+        what :meth:`.colgen.ColumnGeneration.solve` does."""
         s, m, elim = self.search, self.search.master, self.elimination
         bound, x, xa, converged = self.colgen.solve(state, bound)
         if converged and not s.prunable(bound):
@@ -105,7 +106,9 @@ class BranchAndPrice:
             inc = self.incumbents
             inc.dived = True
             inc.dive(min(inc.dive_limit, 0.5 * s.time_left()))
-            m.apply(state)  # back to the root, with the dive's columns
+            if not s.prunable(bound) and inc.primal_calls < 2:
+                inc.call_primal()  # the heuristic again, now that the cut rounds are done
+            m.apply(state)  # back to the root, with the dive's (and heuristic's) columns
             _, x, xa, _ = m.solve()
         return bound, x, xa, converged
 
