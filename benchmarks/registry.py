@@ -181,7 +181,7 @@ METHODS: dict[str, Method] = {m.name: m for m in [
            max_nodes=MILP_MAX_NODES),
     Method("bp", bp, True,
            "branch-and-price: route master on HiGHS, ng-route labelling pricing (numba), greedy's routes "
-           "as first columns, PyVRP as primal heuristic once the root leaves the proof open, 1 thread",
+           "as first columns, PyVRP as primal heuristic when the root leaves the proof open, 1 thread",
            compile_bp),
 ]}
 

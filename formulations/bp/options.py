@@ -62,8 +62,9 @@ class BPOptions:
 
     Incumbents and branching:
 
-    - ``primal_share``, ``primal_cap_s``: time for the caller's ``primal`` heuristic (run once,
-      if the root and its first dive leave the proof open), at most ``primal_cap_s`` seconds.
+    - ``primal_share``, ``primal_cap_s``: time for each call of the caller's ``primal``
+      heuristic (if the root and its first dive leave the proof open, and once more if the
+      root's cut rounds and last dive still do), at most ``primal_cap_s`` seconds.
     - ``dive_share``: time for a dive at the root (30 s without a limit); later dives get less.
     - ``dive_every``, ``milp_every``: a dive every this many nodes, a MILP over the generated
       routes every this many nodes (when new routes came in).
