@@ -295,10 +295,9 @@ def primal_routes(instance: TOPInstance, seed: int):
 
     def run(seconds: float):
         nonlocal calls
-        more = calls > 0
+        res = pyvrp(instance, seed=seed + calls, time_limit=max(seconds, 0.05),
+                    iterations=ITERATIONS if calls == 0 else None)
         calls += 1
-        res = pyvrp(instance, seed=seed + calls - 1, time_limit=max(seconds, 0.05),
-                    iterations=None if more else ITERATIONS)
         return None if res.plan is None else [list(r) for r in res.plan.routes]
 
     return run

@@ -83,17 +83,17 @@ class IncumbentSearch:
             s.stats.milp_s += time.perf_counter() - t
             s.stats.milp_improved += s.incumbent_value > before
 
-    def call_primal(self) -> bool:
+    def call_primal(self) -> None:
         """Run the caller's heuristic (``primal``): its plan becomes columns and, if the verifier
-        passes it and it is better, the incumbent; reports whether it ran. Called when the
-        root's floored bound is settled and the first dive has not found a plan that proves it,
-        so instances the root or its first dive settle (most TOP instances) never pay for it;
-        and once more after the root's cut rounds and last dive if the proof is still open (a
-        heuristic may return another plan when called again: the registered bp's PyVRP then
-        searches with a new seed until its time is up)."""
+        passes it and it is better, the incumbent. Called when the root's floored bound is
+        settled and the first dive has not found a plan that proves it, so instances the root or
+        its first dive settle (most TOP instances) never pay for it; and once more after the
+        root's cut rounds and last dive if the proof is still open (a heuristic may return
+        another plan when called again: the registered bp's PyVRP then searches with a new seed
+        until its time is up)."""
         s = self.search
         if self.primal is None or s.time_left() <= 0:
-            return False
+            return
         self.primal_calls += 1
         t = time.perf_counter()
         allowance = min(self.primal_limit, 0.5 * s.time_left())
@@ -105,7 +105,7 @@ class IncumbentSearch:
         s.stats.primal_s = round((s.stats.primal_s or 0.0) + time.perf_counter() - t, 3)
         s.stats.primal_calls = self.primal_calls
         if not routes:
-            return True
+            return
         pts = [tuple(int(v) + 1 for v in r) for r in routes if len(r)]
         before = s.incumbent_value
         rep = self.offer(pts)
@@ -113,7 +113,6 @@ class IncumbentSearch:
             s.stats.primal_prize = max(float(rep.prize), s.stats.primal_prize or -np.inf)
         s.stats.primal_improved = bool(s.stats.primal_improved) or s.incumbent_value > before
         s.master.add_routes([r for r in pts if s.energy(r) <= s.budget])
-        return True
 
     def dive(self, limit: float, start: NodeState | None = None, *, fresh: bool = False) -> None:
         """Diving: fix the route of largest LP value (its nodes and arcs forced), re-solve the
