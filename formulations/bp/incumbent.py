@@ -39,7 +39,6 @@ class IncumbentSearch:
         self.dive_limit = dive_limit
         self.primal_limit = primal_limit
         self.dived = False  # the root's first dive has run
-        self.primal_calls = 0
         self.dive_starts: set[int] = set()  # first route fixed by each dive so far
 
     def offer(self, routes):
@@ -94,7 +93,7 @@ class IncumbentSearch:
         s = self.search
         if self.primal is None or s.time_left() <= 0:
             return
-        self.primal_calls += 1
+        s.stats.primal_calls += 1
         t = time.perf_counter()
         allowance = min(self.primal_limit, 0.5 * s.time_left())
         try:
@@ -103,7 +102,6 @@ class IncumbentSearch:
             s.stats.primal_error = f"{type(exc).__name__}: {exc}"
             routes = None
         s.stats.primal_s = round((s.stats.primal_s or 0.0) + time.perf_counter() - t, 3)
-        s.stats.primal_calls = self.primal_calls
         if not routes:
             return
         pts = [tuple(int(v) + 1 for v in r) for r in routes if len(r)]

@@ -106,7 +106,7 @@ class BranchAndPrice:
             inc = self.incumbents
             inc.dived = True
             inc.dive(min(inc.dive_limit, 0.5 * s.time_left()))
-            if not s.prunable(bound) and inc.primal_calls < 2:
+            if not s.prunable(bound) and s.stats.primal_calls < 2:
                 inc.call_primal()  # the heuristic again, now that the cut rounds are done
             m.apply(state)  # back to the root, with the dive's (and heuristic's) columns
             _, x, xa, _ = m.solve()
