@@ -26,8 +26,8 @@ def test_same_seed_same_plan(seed):
 
 
 def test_without_an_iteration_limit_the_time_limit_stops_both_passes():
-    """iterations=None (bp's primal heuristic): PyVRP searches until its time is up, past the
-    iterations that stop the registered method; the plan still covers every target."""
+    """iterations=None (bp's primal heuristic): both passes search until their time is up (no
+    iteration stop); the plan still covers every target."""
     inst = to_top(generate(8, 2, 2, 0, e_max=6000.0))
     res = pyvrp(inst, seed=0, time_limit=1.0, iterations=None)
     assert all(res.info[p]["stopped_by"] == "time" for p in ("pass1", "pass2"))
