@@ -20,9 +20,9 @@ top-chao          32 min    the exact methods (milp, cpsat, bp; 60 s) on TOP set
 paper-opt         2.5 h     the paper's grid (Fig. 3 and 4 settings, 20 instances each): every heuristic
                             (5 min) against bp's optimum (60 s at K<=3, 300 s at K=4,5, 600 s at K=6;
                             K<=3 12 min, K=4,5 52 min, K=6 81 min on 2 workers)
-decomposition     ~30 min   clustering / cross-cluster / routing loss of the paper methods, from
+decomposition     ~12 min   clustering / cross-cluster / routing loss of the paper methods, from
                             paper-opt's optima, at N=5 K=3, N=5 K=6 and K=3 N=2..6 (one instance per
-                            worker; K=6 N=5 took 12 min on 2, K=3 N=2..6 39 min in one process)
+                            worker; 755 of its 960 rows took 9.3 min on 2)
 top-4-7           ~5-8 h    bp alone at 600 s on the 192 shipped files of TOP sets 4-7 (~10-15 CPU-hours)
 ================  ========  =========================================================================
 
