@@ -33,6 +33,7 @@ Model (PyVRP's ``Model`` builder):
 
 from __future__ import annotations
 
+import math
 import time
 import warnings
 
@@ -230,16 +231,17 @@ def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: in
 
 
 def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
-          iterations: int | None = ITERATIONS, time_cap: float = TIME_CAP) -> Result:
+          iterations: int | None = ITERATIONS, time_cap: float | None = None) -> Result:
     """Prize-collecting TOP by PyVRP (seeded, iteration-limited) plus group repair.
 
     With groups, pass 1 uses cover copies; pass 2 starts from pass 1's plan without them and
     repairs coverage afterwards (see the module docstring). ``iterations``: each pass's ILS
     iterations at most (None: only the time limit, at most ``time_cap``, stops the passes).
-    ``time_cap``: the registered method's cap on its time (:data:`TIME_CAP`); bp's primal calls
-    after the first lift it (:func:`primal_routes`).
+    ``time_cap``: the most seconds it runs (None: :data:`TIME_CAP`, the registered method's cap);
+    bp's primal calls after the first lift it (:func:`primal_routes`).
     """
     t0 = time.perf_counter()
+    time_cap = TIME_CAP if time_cap is None else time_cap
     cap = min(time_cap if time_limit is None else float(time_limit), time_cap)
     nodes = _useful_nodes(instance)
     info: dict = {"nodes_modelled": int(len(nodes))}
@@ -301,8 +303,7 @@ def primal_routes(instance: TOPInstance, seed: int):
         nonlocal calls
         first = calls == 0
         res = pyvrp(instance, seed=seed + calls, time_limit=max(seconds, 0.05),
-                    iterations=ITERATIONS if first else None,
-                    time_cap=TIME_CAP if first else max(seconds, 0.05))
+                    iterations=ITERATIONS if first else None, time_cap=None if first else math.inf)
         calls += 1
         return None if res.plan is None else [list(r) for r in res.plan.routes]
 

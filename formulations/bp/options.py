@@ -65,8 +65,9 @@ class BPOptions:
     - ``primal_share``, ``primal_cap_s``: time for each call of the caller's ``primal``
       heuristic (if the root and its first dive leave the proof open, and once more if the
       root's cut rounds and last dive still do), at most ``primal_cap_s`` seconds. 30 s: on
-      M = 20, K = 5-6 a 30 s PyVRP search finds plans one better than 10 s on about a third of
-      the instances bp left open, several of them then proven by the root's bound (docs/bp.md).
+      M = 20, K = 5-6 a 30 s PyVRP search found plans one better than bp's (10 s) on about a
+      third of the instances bp left open, several of them then proven by the root's bound
+      (docs/bp.md).
     - ``dive_share``: time for a dive at the root (30 s without a limit); later dives get less.
     - ``dive_every``, ``milp_every``: a dive every this many nodes, a MILP over the generated
       routes every this many nodes (when new routes came in).
