@@ -13,7 +13,7 @@ import pytest
 
 from sarcover.benchmarks.registry import run_method
 from sarcover.formulations.bp import BPOptions, solve_bp
-from sarcover.formulations.bp.options import CUTS_FROM_S, OPEN_CUTS_FROM_S
+from sarcover.formulations.bp.options import CUTS_FROM_S, MORE_PRIMAL_FROM_S, OPEN_CUTS_FROM_S
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.io import load_instance
 from sarcover.formulations.plan import Plan
@@ -578,6 +578,29 @@ def test_primal_runs_again_after_the_root_when_the_proof_stays_open():
     assert math.floor(r.info["root_bound"] + 1e-6) > rep.prize  # the root left it open
     assert len(calls) == 2 == r.info["primal_calls"]
     assert all(0 < c <= 0.1 * 60 + 1e-9 for c in calls)
+    calls.clear()
+    r = solve_bp(inst, time_limit=60, primal=lambda seconds: calls.append(seconds),
+                 options=BPOptions(cut_rounds=0, primal_calls=4))
+    assert r.status == Status.OPTIMAL and verify(inst, r.plan).prize == rep.prize
+    assert len(calls) == 4 == r.info["primal_calls"]  # the extra calls, one after the other
+
+
+def test_later_primal_calls_stop_once_a_plan_proves_the_root():
+    """The root calls the heuristic again only while its proof is open: on p1.2.p (root bound =
+    optimum) with the dives off, a heuristic that finds nothing on its first call and the optimum
+    on its second is not called a third time, whatever primal_calls allows."""
+    inst = _top("p1.2.p")
+    ref = solve_bp(inst, time_limit=30)
+    assert ref.status == Status.OPTIMAL
+    calls = []
+
+    def primal(seconds):
+        calls.append(seconds)
+        return [list(r) for r in ref.plan.routes] if len(calls) == 2 else None
+
+    r = solve_bp(inst, time_limit=60, primal=primal, options=BPOptions(primal_calls=6, dive_share=0.0))
+    assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p1.2.p"])
+    assert len(calls) == 2 == r.info["primal_calls"]
 
 
 def test_primal_is_not_run_when_the_root_proves():
@@ -1025,11 +1048,12 @@ def test_cuts_match_brute_force(seed):
 
 
 @pytest.mark.parametrize("offset", [0.0, -1.0])
-@pytest.mark.parametrize("threshold", ["CUTS_FROM_S", "OPEN_CUTS_FROM_S"])
+@pytest.mark.parametrize("threshold", ["CUTS_FROM_S", "OPEN_CUTS_FROM_S", "MORE_PRIMAL_FROM_S"])
 def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, threshold):
-    """The registered bp spends a moment on greedy before solve_bp; whether cuts are on, and how
-    open their gate is, follow the user's time limit (at CUTS_FROM_S: on; at OPEN_CUTS_FROM_S:
-    open), not the slightly smaller one left for solve_bp."""
+    """The registered bp spends a moment on greedy before solve_bp; whether cuts are on, how
+    open their gate is and how often the primal heuristic runs follow the user's time limit (at
+    CUTS_FROM_S: on; at OPEN_CUTS_FROM_S: open; at MORE_PRIMAL_FROM_S: 4 calls), not the
+    slightly smaller one left for solve_bp."""
     import sarcover.formulations.bp as bp_package
     import sarcover.formulations.bp.options as bp_options
     from sarcover.benchmarks.registry import METHODS
@@ -1049,6 +1073,7 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, thre
     assert seen["time_limit"] < limit
     assert seen["options"].cut_rounds == default_cut_rounds(limit) == (6 if limit >= CUTS_FROM_S else 0)
     assert seen["options"].cut_gap == default_cut_gap(limit) == (1.0 if limit >= OPEN_CUTS_FROM_S else 0.5)
+    assert seen["options"].primal_calls == (4 if limit >= MORE_PRIMAL_FROM_S else 2)
 
 
 def test_cuts_are_on_by_default_for_long_runs_only():
@@ -1077,7 +1102,7 @@ def test_cut_gate_opens_for_long_runs():
 
 
 @pytest.mark.parametrize("limit", [CUTS_FROM_S - 1, CUTS_FROM_S, OPEN_CUTS_FROM_S - 1,
-                                   OPEN_CUTS_FROM_S, None])
+                                   OPEN_CUTS_FROM_S, MORE_PRIMAL_FROM_S - 1, MORE_PRIMAL_FROM_S, None])
 def test_options_for_time_limit(limit):
     """BPOptions.for_time_limit: the defaults, with the cut settings decided on the limit (cuts
     on from CUTS_FROM_S, their gate open from OPEN_CUTS_FROM_S); options that leave them None
@@ -1087,7 +1112,8 @@ def test_options_for_time_limit(limit):
     opts = BPOptions.for_time_limit(limit)
     on, open_gate = limit is None or limit >= CUTS_FROM_S, limit is None or limit >= OPEN_CUTS_FROM_S
     assert opts.cut_rounds == (6 if on else 0) and opts.cut_gap == (1.0 if open_gate else 0.5)
-    assert dataclasses.replace(opts, cut_rounds=None, cut_gap=None) == BPOptions()
+    assert opts.primal_calls == (4 if limit is None or limit >= MORE_PRIMAL_FROM_S else 2)
+    assert dataclasses.replace(opts, cut_rounds=None, cut_gap=None, primal_calls=None) == BPOptions()
     assert BPOptions().with_limit_defaults(limit) == opts
     assert BPOptions(cut_rounds=2, strong=1).with_limit_defaults(limit).cut_rounds == 2
     with pytest.raises(dataclasses.FrozenInstanceError):

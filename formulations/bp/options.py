@@ -14,12 +14,20 @@ from dataclasses import dataclass, replace
 
 CUTS_FROM_S = 60.0  # time limits from which subset-row cuts are on by default
 OPEN_CUTS_FROM_S = 300.0  # ... and from which they are tried however far the LP is from a drop
+MORE_PRIMAL_FROM_S = 600.0  # time limits from which the root calls the primal heuristic 4 times
 
 
 def default_cut_rounds(time_limit: float | None) -> int:
     """Rounds of subset-row cuts by default: 6 from ``CUTS_FROM_S`` (and without a limit),
     else 0."""
     return 6 if time_limit is None or float(time_limit) >= CUTS_FROM_S else 0
+
+
+def default_primal_calls(time_limit: float | None) -> int:
+    """Calls of the caller's primal heuristic at the root by default (while the proof stays
+    open): 2, and 4 from ``MORE_PRIMAL_FROM_S`` (and without a limit), where the two extra
+    30 s searches cost a tenth of the limit, a few of the tree's 7-15 s nodes at K = 5-6."""
+    return 4 if time_limit is None or float(time_limit) >= MORE_PRIMAL_FROM_S else 2
 
 
 def default_cut_gap(time_limit: float | None) -> float:
@@ -62,9 +70,12 @@ class BPOptions:
 
     Incumbents and branching:
 
+    - ``primal_calls``: the most calls of the caller's ``primal`` heuristic, all at the root:
+      one if the root and its first dive leave the proof open, the others one after the other
+      while the root's cut rounds and last dive still do (each with a new seed, for the
+      registered bp's PyVRP); None: by the time limit (:func:`default_primal_calls`).
     - ``primal_share``, ``primal_cap_s``: time for each call of the caller's ``primal``
-      heuristic (if the root and its first dive leave the proof open, and once more if the
-      root's cut rounds and last dive still do), at most ``primal_cap_s`` seconds. 30 s: on
+      heuristic, at most ``primal_cap_s`` seconds. 30 s: on
       M = 20, K = 5-6 a 30 s PyVRP search found plans one better than bp's (10 s) on about a
       third of the instances bp left open, several of them then proven by the root's bound
       (docs/bp.md).
@@ -104,6 +115,7 @@ class BPOptions:
     cuts_per_round: int = 16
     cut_gap: float | None = None
     cut_share: float = 0.35
+    primal_calls: int | None = None
     primal_share: float = 0.1
     primal_cap_s: float = 30.0
     dive_share: float = 0.1
@@ -125,11 +137,13 @@ class BPOptions:
         return cls().with_limit_defaults(time_limit)
 
     def with_limit_defaults(self, time_limit: float | None) -> "BPOptions":
-        """These options with the settings left None (``cut_rounds``, ``cut_gap``) decided on
-        ``time_limit``."""
+        """These options with the settings left None (``cut_rounds``, ``cut_gap``,
+        ``primal_calls``) decided on ``time_limit``."""
         return replace(
             self,
             cut_rounds=(default_cut_rounds(time_limit) if self.cut_rounds is None
                         else self.cut_rounds),
-            cut_gap=default_cut_gap(time_limit) if self.cut_gap is None else self.cut_gap)
+            cut_gap=default_cut_gap(time_limit) if self.cut_gap is None else self.cut_gap,
+            primal_calls=(default_primal_calls(time_limit) if self.primal_calls is None
+                          else self.primal_calls))
 

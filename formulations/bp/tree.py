@@ -106,8 +106,10 @@ class BranchAndPrice:
             inc = self.incumbents
             inc.dived = True
             inc.dive(min(inc.dive_limit, 0.5 * s.time_left()))
-            if not s.prunable(bound) and s.stats.primal_calls < 2:
-                inc.call_primal()  # the heuristic again, now that the cut rounds are done
+            # the heuristic again, now that the cut rounds are done: each call is another draw
+            while (not s.prunable(bound) and inc.primal is not None and s.time_left() > 0
+                   and s.stats.primal_calls < self.options.primal_calls):
+                inc.call_primal()
             m.apply(state)  # back to the root, with the dive's (and heuristic's) columns
             _, x, xa, _ = m.solve()
         return bound, x, xa, converged
