@@ -542,18 +542,24 @@ def _prize(inst, result):
     return rep.prize
 
 
+def _p12p_with_optimum():
+    """p1.2.p and bp's optimal routes on it (node ids), for tests that feed bp a primal plan."""
+    inst = _top("p1.2.p")
+    ref = solve_bp(inst, time_limit=30)
+    assert ref.status == Status.OPTIMAL
+    return inst, [list(r) for r in ref.plan.routes]
+
+
 def test_primal_plan_becomes_the_incumbent_when_the_root_needs_it():
     """``primal`` runs once, after the root and its first dive leave the proof open (p1.2.p);
     a verified plan it returns is taken as incumbent and its routes as columns; the run still
     proves the published optimum."""
-    inst = _top("p1.2.p")
-    ref = solve_bp(inst, time_limit=30)
-    assert ref.status == Status.OPTIMAL
+    inst, optimum = _p12p_with_optimum()
     calls = []
 
     def primal(seconds):
         calls.append(seconds)
-        return [list(r) for r in ref.plan.routes]
+        return optimum
 
     r = solve_bp(inst, time_limit=60, primal=primal)
     assert len(calls) == 1 and 0 < calls[0] <= 0.1 * 60 + 1e-9
@@ -565,7 +571,8 @@ def test_primal_plan_becomes_the_incumbent_when_the_root_needs_it():
 def test_primal_runs_again_after_the_root_when_the_proof_stays_open():
     """On an instance whose root bound stays above every plan (M = 12, K = 3, N = 3, seed 0,
     no cuts), the heuristic runs after the first dive and once more after the root's last
-    dive, never more; the run still proves its plan optimal."""
+    dive, never more by default at 60 s, and primal_calls times in all when asked; the run
+    still proves its plan optimal."""
     from sarcover.formulations.generate import generate
     from sarcover.formulations.instance import to_top
 
@@ -589,14 +596,12 @@ def test_later_primal_calls_stop_once_a_plan_proves_the_root():
     """The root calls the heuristic again only while its proof is open: on p1.2.p (root bound =
     optimum) with the dives off, a heuristic that finds nothing on its first call and the optimum
     on its second is not called a third time, whatever primal_calls allows."""
-    inst = _top("p1.2.p")
-    ref = solve_bp(inst, time_limit=30)
-    assert ref.status == Status.OPTIMAL
+    inst, optimum = _p12p_with_optimum()
     calls = []
 
     def primal(seconds):
         calls.append(seconds)
-        return [list(r) for r in ref.plan.routes] if len(calls) == 2 else None
+        return optimum if len(calls) == 2 else None
 
     r = solve_bp(inst, time_limit=60, primal=primal, options=BPOptions(primal_calls=6, dive_share=0.0))
     assert r.status == Status.OPTIMAL and _prize(inst, r) == pytest.approx(OPTIMAL["p1.2.p"])
