@@ -571,8 +571,8 @@ def test_primal_plan_becomes_the_incumbent_when_the_root_needs_it():
 def test_primal_runs_again_after_the_root_when_the_proof_stays_open():
     """On an instance whose root bound stays above every plan (M = 12, K = 3, N = 3, seed 0,
     no cuts), the heuristic runs after the first dive and once more after the root's last
-    dive, never more by default at 60 s, and primal_calls times in all when asked; the run
-    still proves its plan optimal."""
+    dive, never more by default at 60 s, and primal_calls times in all when asked (0: never);
+    the run still proves its plan optimal."""
     from sarcover.formulations.generate import generate
     from sarcover.formulations.instance import to_top
 
@@ -590,6 +590,11 @@ def test_primal_runs_again_after_the_root_when_the_proof_stays_open():
                  options=BPOptions(cut_rounds=0, primal_calls=4))
     assert r.status == Status.OPTIMAL and verify(inst, r.plan).prize == rep.prize
     assert len(calls) == 4 == r.info["primal_calls"]  # the extra calls, one after the other
+    calls.clear()
+    r = solve_bp(inst, time_limit=60, primal=lambda seconds: calls.append(seconds),
+                 options=BPOptions(cut_rounds=0, primal_calls=0))
+    assert r.status == Status.OPTIMAL and verify(inst, r.plan).prize == rep.prize
+    assert calls == [] and r.info["primal_calls"] == 0  # 0: the heuristic is never called
 
 
 def test_later_primal_calls_stop_once_a_plan_proves_the_root():
