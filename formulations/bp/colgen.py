@@ -133,8 +133,7 @@ class ColumnGeneration:
         s, inc = self.search, self.incumbents
         inc.dived = True
         inc.dive(min(inc.dive_limit, 0.5 * s.time_left()))
-        if not s.prunable(bound) and inc.primal is not None and s.options.primal_calls > 0:
-            inc.call_primal()
+        if not s.prunable(bound) and inc.call_primal():
             if not s.prunable(bound):  # dive again, now with the heuristic's columns
                 s.master.apply(state)  # (its LP differs: any start route, even the first's)
                 inc.dive(min(inc.dive_limit, 0.5 * s.time_left()), fresh=True)

@@ -83,17 +83,18 @@ class IncumbentSearch:
             s.stats.milp_s += time.perf_counter() - t
             s.stats.milp_improved += s.incumbent_value > before
 
-    def call_primal(self) -> None:
-        """Run the caller's heuristic (``primal``): its plan becomes columns and, if the verifier
-        passes it and it is better, the incumbent. Called when the root's floored bound is
+    def call_primal(self) -> bool:
+        """Run the caller's heuristic (``primal``), unless there is none, no time is left or it
+        has had its ``primal_calls`` calls; returns whether it ran. Its plan becomes columns
+        and, if the verifier passes it and it is better, the incumbent. Called when the root's floored bound is
         settled and the first dive has not found a plan that proves it, so instances the root or
         its first dive settle (most TOP instances) never pay for it; and again after the root's
         cut rounds and last dive while the proof is still open, up to ``primal_calls`` calls in
         all (a heuristic may return another plan when called again: the registered bp's PyVRP
         then searches with a new seed until its time is up)."""
         s = self.search
-        if self.primal is None or s.time_left() <= 0:
-            return
+        if self.primal is None or s.time_left() <= 0 or s.stats.primal_calls >= s.options.primal_calls:
+            return False
         s.stats.primal_calls += 1
         t = time.perf_counter()
         allowance = min(self.primal_limit, 0.5 * s.time_left())
@@ -104,7 +105,7 @@ class IncumbentSearch:
             routes = None
         s.stats.primal_s = round((s.stats.primal_s or 0.0) + time.perf_counter() - t, 3)
         if not routes:
-            return
+            return True
         pts = [tuple(int(v) + 1 for v in r) for r in routes if len(r)]
         before = s.incumbent_value
         rep = self.offer(pts)
@@ -112,6 +113,7 @@ class IncumbentSearch:
             s.stats.primal_prize = max(float(rep.prize), s.stats.primal_prize or -np.inf)
         s.stats.primal_improved = bool(s.stats.primal_improved) or s.incumbent_value > before
         s.master.add_routes([r for r in pts if s.energy(r) <= s.budget])
+        return True
 
     def dive(self, limit: float, start: NodeState | None = None, *, fresh: bool = False) -> None:
         """Diving: fix the route of largest LP value (its nodes and arcs forced), re-solve the

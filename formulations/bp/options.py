@@ -26,7 +26,7 @@ def default_cut_rounds(time_limit: float | None) -> int:
 def default_primal_calls(time_limit: float | None) -> int:
     """Calls of the caller's primal heuristic at the root by default (while the proof stays
     open): 2, and 4 from ``MORE_PRIMAL_FROM_S`` (and without a limit), where the two extra
-    30 s searches cost a tenth of the limit, a few of the tree's 7-15 s nodes at K = 5-6."""
+    searches take a small share of the limit from the tree (docs/bp.md)."""
     return 4 if time_limit is None or float(time_limit) >= MORE_PRIMAL_FROM_S else 2
 
 

@@ -107,9 +107,8 @@ class BranchAndPrice:
             inc.dived = True
             inc.dive(min(inc.dive_limit, 0.5 * s.time_left()))
             # the heuristic again, now that the cut rounds are done: each call is another draw
-            while (not s.prunable(bound) and inc.primal is not None and s.time_left() > 0
-                   and s.stats.primal_calls < self.options.primal_calls):
-                inc.call_primal()
+            while not s.prunable(bound) and inc.call_primal():
+                pass
             m.apply(state)  # back to the root, with the dive's (and heuristic's) columns
             _, x, xa, _ = m.solve()
         return bound, x, xa, converged
