@@ -603,17 +603,29 @@ def _run_suite(suite, out_dir, workers, resume, scheduler, address, progress, st
             store.append(row)
             bar.update(row["status"])
 
-        if scheduler:
-            run_dask(payload, emit, scheduler=scheduler)
-        else:
-            run_local(payload, emit, workers=workers, memory_mb=suite.memory_mb)
-        wall = time.monotonic() - t0
-        with (store.directory / "runs.jsonl").open("a") as fh:
-            fh.write(json.dumps({"suite": suite.name, "started_at": started, "finished_at": _now(),
-                                 "wall_s": wall, "jobs": len(todo), "already_stored": stored,
-                                 "workers": None if scheduler else workers,
-                                 "scheduler": address if isinstance(address, str) else None,
-                                 "command": shlex.join(sys.argv), **environment()}) + "\n")
+        def record(jobs: int, interrupted: bool) -> float:
+            """Append this run's record to runs.jsonl (the report's "how it was run"); a run
+            stopped by Ctrl-C is recorded too, with the jobs it stored, so a long run finished
+            in several parts still says how long each part took."""
+            wall = time.monotonic() - t0
+            with (store.directory / "runs.jsonl").open("a") as fh:
+                fh.write(json.dumps({"suite": suite.name, "started_at": started, "finished_at": _now(),
+                                     "wall_s": wall, "jobs": jobs, "already_stored": stored,
+                                     "interrupted": interrupted, "workers": None if scheduler else workers,
+                                     "scheduler": address if isinstance(address, str) else None,
+                                     "command": shlex.join(sys.argv), **environment()}) + "\n")
+            return wall
+
+        try:
+            if scheduler:
+                run_dask(payload, emit, scheduler=scheduler)
+            else:
+                run_local(payload, emit, workers=workers, memory_mb=suite.memory_mb)
+        except KeyboardInterrupt:
+            if bar.done:
+                record(bar.done, True)
+            raise
+        wall = record(len(todo), False)
         return {"suite": suite.name, "jobs": len(suite.jobs), "ran": len(todo), "stored_before": stored,
                 "wall_s": wall, "counts": dict(bar.counts), "path": str(store.path)}
     finally:

@@ -146,7 +146,8 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
         for w in _walls(root, s):
             if not w["jobs"]:
                 continue  # a resume that found everything stored
-            L.append(f"| {s} | {w['jobs']} | {w['wall_s']:.0f} | {w['workers']} | {w.get('cpu_count')} | "
+            jobs = f"{w['jobs']} (stopped)" if w.get("interrupted") else w["jobs"]
+            L.append(f"| {s} | {jobs} | {w['wall_s']:.0f} | {w['workers']} | {w.get('cpu_count')} | "
                      f"{w['finished_at']} |")
     for name, df in [("paper-n", pn), ("paper-k", pk)]:
         if df is not None:

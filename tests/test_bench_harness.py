@@ -358,6 +358,27 @@ def test_ctrl_c_in_a_worker_stops_the_run_without_storing_its_job(tmp_path, caps
     assert "interrupted" not in text
 
 
+def test_ctrl_c_records_the_part_of_the_run_that_was_stored(tmp_path):
+    """A run stopped by Ctrl-C after some jobs still appends its record to runs.jsonl (marked
+    interrupted, with the jobs it stored), and the report's "how it was run" shows it as stopped;
+    a run stopped before storing anything leaves no record."""
+    from sarcover.reports.reference import _walls, write_reference
+
+    body = ('methods = ["greedy", "bench_methods:interrupted"]\ntime_limit = 5\n'
+            '[[instances]]\nM = 2\nK = 2\nN = 1\nruns = 1\n')
+    suite = write_suite(tmp_path, body)
+    out = tmp_path / "res"
+    assert main(["bench", str(suite), "-o", str(out), "--workers", "1", "--quiet"]) == 130
+    assert [r["method"] for r in rows_of(out)] == ["greedy"]
+    records = _walls(tmp_path, "res")
+    assert len(records) == 1 and records[0]["interrupted"] is True and records[0]["jobs"] == 1
+    readme = write_reference(tmp_path, tmp_path / "report", suites=["res"]).read_text()
+    assert "| res | 1 (stopped) |" in readme
+    # the resume stops at the same job before storing anything: no second record
+    assert main(["bench", str(suite), "-o", str(out), "--workers", "1", "--quiet", "--resume"]) == 130
+    assert len(_walls(tmp_path, "res")) == 1
+
+
 WARM_CHECK = r"""
 import json, sys
 from numba.core.registry import CPUDispatcher
