@@ -29,7 +29,8 @@ top-4-7           ~5-8 h    bp alone at 600 s on the 192 shipped files of TOP se
 ``--runs R`` sets the random instances per setting of paper-n and paper-k (the paper: 1000, the
 default); ``--skip STEP`` leaves a suite or the decomposition out; ``--report-only`` only rewrites
 the report. Every step resumes: a stopped run continues where it stopped. The results directory
-(raw JSON Lines rows) is not committed; the report's CSVs are.
+(raw JSON Lines rows) is not committed; the report's CSVs are (top-4-7's first 165 files, too long
+for one sitting, keep their raw rows in ``reports/top-4-7/rows/`` to resume from).
 """
 
 from __future__ import annotations
