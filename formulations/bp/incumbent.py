@@ -28,8 +28,8 @@ if TYPE_CHECKING:
 class IncumbentSearch:
     """Incumbents of one run. ``primal(seconds) -> routes or None`` (node ids): the caller's
     heuristic, run at most ``options.primal_calls`` times (at the root) with up to
-    ``primal_limit`` seconds each;
-    ``dive_limit``: seconds for a dive at the root (later dives get less)."""
+    ``primal_limit`` seconds each; ``dive_limit``: seconds for a dive at the root (later dives
+    get less)."""
 
     def __init__(self, search: "Search", pricer: "Pricer", elimination: "Elimination", primal,
                  *, dive_limit: float, primal_limit: float):
@@ -85,13 +85,13 @@ class IncumbentSearch:
 
     def call_primal(self) -> bool:
         """Run the caller's heuristic (``primal``), unless there is none, no time is left or it
-        has had its ``primal_calls`` calls; returns whether it ran. Its plan becomes columns
-        and, if the verifier passes it and it is better, the incumbent. Called when the root's floored bound is
-        settled and the first dive has not found a plan that proves it, so instances the root or
-        its first dive settle (most TOP instances) never pay for it; and again after the root's
-        cut rounds and last dive while the proof is still open, up to ``primal_calls`` calls in
-        all (a heuristic may return another plan when called again: the registered bp's PyVRP
-        then searches with a new seed until its time is up)."""
+        has had its ``primal_calls`` calls; returns whether it ran. Its plan becomes columns and,
+        if the verifier passes it and it is better, the incumbent. Called when the root's floored
+        bound is settled and the first dive has not found a plan that proves it, so instances the
+        root or its first dive settle (most TOP instances) never pay for it; and again after the
+        root's cut rounds and last dive while the proof is still open, up to ``primal_calls``
+        calls in all (a heuristic may return another plan when called again: the registered bp's
+        PyVRP then searches with a new seed until its time is up)."""
         s = self.search
         if self.primal is None or s.time_left() <= 0 or s.stats.primal_calls >= s.options.primal_calls:
             return False
