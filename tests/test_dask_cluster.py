@@ -73,7 +73,17 @@ def cluster(tmp_path_factory):
         log.close()
 
 
+def _both_workers_up(address):
+    """Wait until both worker processes are registered: at the start, and after a test whose
+    workers were killed (each nanny restarts its worker, which takes seconds on a busy machine)."""
+    from dask.distributed import Client
+
+    with Client(address, timeout="30s") as client:
+        client.wait_for_workers(2, timeout=120)
+
+
 def _bench(tmp_path, env, address, body):
+    _both_workers_up(address)
     suite = tmp_path / "suite.toml"
     suite.write_text(body)
     return subprocess.Popen([sys.executable, "-m", "sarcover.benchmarks.cli", "bench", str(suite), "-o",
@@ -81,9 +91,18 @@ def _bench(tmp_path, env, address, body):
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
 
 
-def _finish(bench):
+def _finish(bench, tmp_path, marks):
+    """Wait for the bench run; if it hangs, fail with what it and the cluster said."""
     try:
-        _, stderr = bench.communicate(timeout=120)
+        _, stderr = bench.communicate(timeout=180)
+    except subprocess.TimeoutExpired:
+        _stop(bench)
+        _, stderr = bench.communicate()
+        rows = (tmp_path / "res" / "results.jsonl")
+        stored = len(rows.read_text().splitlines()) if rows.exists() else 0
+        log = (marks.parent / "cluster.log").read_text().splitlines()
+        raise AssertionError(f"the bench run did not end in 180 s ({stored} rows stored); its stderr:\n{stderr}\n"
+                             "the cluster's log, last 40 lines:\n" + "\n".join(log[-40:])) from None
     finally:
         _stop(bench)
     assert bench.returncode == 0, stderr
@@ -104,7 +123,7 @@ def test_killing_a_worker_mid_job_loses_no_job_and_stores_one_row_each(cluster, 
         victim_job, victim_pid = first.name.rsplit(".", 1)
         os.kill(int(victim_pid), signal.SIGKILL)  # a worker process dies in the middle of its job
     finally:
-        _finish(bench)
+        _finish(bench, tmp_path, marks)
     rows = _rows(tmp_path / "res")
     assert len(rows) == JOBS and len({r["key"] for r in rows}) == JOBS  # one row per job, none lost
     assert all(r["status"] == "optimal" and r["valid"] for r in rows)  # the killed job was retried
@@ -120,7 +139,7 @@ def test_a_job_that_kills_every_worker_becomes_an_error_row(cluster, tmp_path):
     worker would be given up too.)"""
     from dask.distributed import Client
 
-    address, env, _ = cluster
+    address, env, marks = cluster
 
     def set_allowed_failures(n, dask_scheduler=None):
         before, dask_scheduler.allowed_failures = dask_scheduler.allowed_failures, n
@@ -130,7 +149,8 @@ def test_a_job_that_kills_every_worker_becomes_an_error_row(cluster, tmp_path):
         before = client.run_on_scheduler(set_allowed_failures, 0)
         try:
             _finish(_bench(tmp_path, env, address, 'name = "dask-die"\nmethods = ["bench_methods:die"]\n'
-                           'time_limit = 30\n[[instances]]\nM = 2\nK = 2\nN = 1\nruns = 2\n'))
+                           'time_limit = 30\n[[instances]]\nM = 2\nK = 2\nN = 1\nruns = 2\n'),
+                    tmp_path, marks)
         finally:
             client.run_on_scheduler(set_allowed_failures, before)
     rows = _rows(tmp_path / "res")
