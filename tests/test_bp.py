@@ -991,6 +991,66 @@ def test_purged_cuts_leave_the_lp_and_free_their_bits():
     assert m.add_cuts([idle]) == 1 and int(m.cut_members[4]) == 2  # the next free bit
 
 
+def test_removed_cuts_leave_the_lp_whatever_their_dual():
+    """remove_cuts drops the cuts asked for, even one the LP leans on: the LP gets weaker by
+    exactly that row, and the kept cuts' rows and bits are renumbered."""
+    from sarcover.formulations.bp.master import Master
+
+    m = Master(6, np.ones(6), [], 6)
+    m.add_routes([(1, 2), (2, 3), (1, 3), (4,), (5,), (6,)])
+    idle = ((4, 5, 6), frozenset({4, 5, 6}))
+    assert m.add_cuts([((1, 2, 3), frozenset({1, 2, 3})), idle]) == 2
+    value, _, _, y = m.solve()
+    assert value == pytest.approx(5.0) and m.cut_duals(y)[0] > 0
+    assert m.remove_cuts([0]) == 1
+    assert m.cuts == [(4, 5, 6)] and m.n_rows == m.base_rows + 1 == m.h.getNumRow()
+    assert [int(b) for b in m.cut_members[1:7]] == [0, 0, 0, 1, 1, 1]
+    assert m.solve()[0] == pytest.approx(6.0)  # the triangle at 1/2 each again
+    assert m.remove_cuts([]) == 0 and m.cuts == [(4, 5, 6)]
+
+
+def test_label_cap_under_cuts_withdraws_the_last_round_and_still_proves():
+    """An exact pricing that hits its label cap certifies no bound. Under cuts, the root then
+    withdraws the last round's cuts and tries no more rounds, instead of giving up the run (TOP
+    set 5's p5.2.x stopped at 30 s of 600 that way). The cap is simulated on the first exact
+    call after a cut round; p2.2.k's published optimum is still proven."""
+    from sarcover.formulations.bp.pricing import PricingResult
+    from sarcover.formulations.bp.tree import BranchAndPrice
+
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    bp = BranchAndPrice(inst, time_limit=60, options=BPOptions(cut_rounds=4, cut_gap=100.0, cut_share=1.0))
+    exact, capped = bp.pricer.exact, []
+
+    def capped_once_under_cuts(*args):
+        res = exact(*args)
+        if bp.search.master.cuts and not capped:
+            capped.append(len(bp.search.master.cuts))
+            return PricingResult(res.best, False, res.routes, [], res.n_labels, res.ng_routes)
+        return res
+
+    bp.pricer.exact = capped_once_under_cuts
+    proven, bound = bp.run()
+    stats = bp.search.stats
+    assert capped and stats.label_caps == 1
+    # the cap came right after the first round: all of its cuts were withdrawn, none are left
+    assert stats.cuts_withdrawn == capped[0] > 0 and bp.search.master.cuts == []
+    assert bp.cuts.rounds == bp.cuts.done  # no round after the withdrawal
+    assert proven and bound == pytest.approx(OPTIMAL["p2.2.k"])
+
+
+def test_label_cap_without_cuts_branches_instead_of_stopping():
+    """With no cuts to withdraw, a node whose exact pricing hits the label cap is branched on
+    its unconverged LP (its bound still holds) until the time is up: the run neither stops at
+    the root nor claims more than it proved, and its plan is valid."""
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    r = solve_bp(inst, time_limit=4, options=BPOptions(cut_rounds=0, exact_labels=1))
+    assert r.info["label_caps"] > 1 and r.info["nodes"] > 1
+    assert verify(inst, r.plan).valid and _prize(inst, r) <= OPTIMAL["p2.2.k"]
+    assert r.bound >= OPTIMAL["p2.2.k"] - 1e-6
+    if r.status == Status.OPTIMAL:
+        assert _prize(inst, r) == pytest.approx(OPTIMAL["p2.2.k"])
+
+
 def test_purging_cuts_keeps_the_published_optimum():
     """Rounds of 48 cuts on p2.2.k pass the 64-cut limit, so idle cuts are purged between
     rounds; the published optimum is still proven."""

@@ -60,7 +60,8 @@ class ColumnGeneration:
     def solve(self, state: NodeState, bound: float):
         """Solve one node's LP by column generation, starting from the parent's ``bound``.
         Returns (bound, x, x_art, converged); not converged: out of time, or an exact pricing
-        hit its label cap."""
+        hit its label cap (at the root first without the last cut round, see
+        :meth:`.cuts.CutRounds.withdraw`)."""
         s, m, pricer, elim = self.search, self.search.master, self.pricer, self.elimination
         version = None
         arcs_decided = bool(state.forbidden_arcs or state.forced_arcs)
@@ -92,6 +93,14 @@ class ColumnGeneration:
             gain = y0 + (self.slack(m.lagrangian_bound(y, y0)) if state.depth else 0.0)
             res = pricer.exact(cost, ret, prof, allowed, gain, sig)
             s.stats.exact_pricings += 1
+            if not res.exact and s.time_left() > 0:
+                # the label cap, not the clock: no bound from this call. Under the last cut
+                # round's cuts, withdraw them and go on; otherwise the node stays unconverged
+                s.stats.label_caps += 1
+                m.add_routes(pricer.columns(res))
+                if state.depth == 0 and self.cuts.withdraw():
+                    continue
+                return bound, x, xa, False
             if res.exact:
                 lag = m.lagrangian_bound(y, res.best)
                 if state.depth == 0:

@@ -12,6 +12,11 @@ Each round makes the pricing slower (on M = 20, K = 5 an exact call took about t
 after each round of 16 cuts), so a round is started only if, taking twice as long as the round
 before it (from its start to now), it would still end within the cut share: a round that starts
 just before the share ends can otherwise hold the root for most of the run.
+
+A round can also make the labelling explode (TOP set 5's two-vehicle files: an exact call of
+38 000 labels before a round of 16 cuts passed the 2 000 000-label cap after it). An exact
+call that hits the cap gives no bound, so the last round is withdrawn (:meth:`CutRounds.withdraw`)
+and no more are tried: the bound certified before it stands, and the root goes on without it.
 """
 
 from __future__ import annotations
@@ -45,6 +50,7 @@ class CutRounds:
         self.done = 0  # rounds separated so far
         self.started = None  # when the last round was separated (time.perf_counter())
         self.labelled = False  # the labelling arc bounds ran before the first round
+        self.last = []  # the triples of the last round's cuts (withdrawn if pricing explodes)
 
     def add(self, state: NodeState, x, y, lp_value: float) -> bool:
         """Separate cuts violated by the node's LP solution ``x`` (duals ``y``, value
@@ -81,5 +87,21 @@ class CutRounds:
             if purged:
                 self.elimination.forget()  # its duals refer to rows that are gone
         added = m.add_cuts(m.separate_cuts(x, self.per_round))
+        self.last = m.cuts[len(m.cuts) - added:]  # add_cuts appends
         s.stats.cuts += added
         return added > 0
+
+    def withdraw(self) -> bool:
+        """Remove the last round's cuts and try no more rounds (an exact pricing under them hit
+        its label cap); report whether any were removed."""
+        m = self.search.master
+        self.rounds = self.done
+        last = set(self.last)
+        drop = [c for c, S in enumerate(m.cuts) if S in last]
+        self.last = []
+        if not drop:
+            return False
+        removed = m.remove_cuts(drop)
+        self.search.stats.cuts_withdrawn += removed
+        self.elimination.forget()  # its duals refer to rows that are gone
+        return True

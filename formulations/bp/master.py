@@ -283,8 +283,12 @@ class Master:
         so dropping some only weakens the LP, and one of zero dual leaves the LP optimum as is."""
         if not self.cuts:
             return 0
-        duals = self.cut_duals(y)
-        drop = np.flatnonzero(duals <= tol)
+        return self.remove_cuts(np.flatnonzero(self.cut_duals(y) <= tol))
+
+    def remove_cuts(self, drop) -> int:
+        """Remove the cut rows at positions ``drop`` (in cut order); return how many. Valid at
+        any time: every cut holds for every plan, so the LP only gets weaker."""
+        drop = np.unique(np.asarray(drop, dtype=np.int64))
         if drop.size == 0:
             return 0
         rows = (drop + self.base_rows).astype(np.int32)
@@ -294,7 +298,8 @@ class Master:
         self.row_lo, self.row_hi, self.cur_lo, self.cur_hi = (
             a[keep_row] for a in (self.row_lo, self.row_hi, self.cur_lo, self.cur_hi))
         self.n_rows -= int(rows.size)
-        kept = [c for c in range(len(self.cuts)) if duals[c] > tol]
+        gone = set(drop.tolist())
+        kept = [c for c in range(len(self.cuts)) if c not in gone]
         self.cuts = [self.cuts[c] for c in kept]
         self.memories = [self.memories[c] for c in kept]
         self.cut_members[:] = 0

@@ -56,6 +56,9 @@ class BPOptions:
       never raises the threshold. 0.5: fewer exact calls at the root, more cut rounds in time
       (docs/bp.md).
     - ``ng_cap``: the most points an ng set grows to when LP routes repeat a point.
+    - ``exact_labels``: an exact pricing call gives up beyond this many labels (memory: about
+      100 bytes each). Such a call certifies no bound: at the root the last cut round is
+      withdrawn; otherwise the node is branched on its unconverged LP.
     - ``grow_share``: ng sets only grow within this share of the limit (larger sets make pricing
       slower; after that, branching decides).
 
@@ -110,6 +113,7 @@ class BPOptions:
     ng_columns: bool = True
     exact_keep: float = 0.5
     ng_cap: int = 12
+    exact_labels: int = 2_000_000
     grow_share: float = 0.3
     cut_rounds: int | None = None
     cuts_per_round: int = 16

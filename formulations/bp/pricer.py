@@ -17,14 +17,15 @@ if TYPE_CHECKING:
 class Pricer:
     """Pricing calls of one run. ``bidirectional``: the exact pricing direction; None until the
     first exact call has measured both. ``keep``: the exact calls' share of near-best routes
-    (:func:`.pricing.price`)."""
+    (:func:`.pricing.price`); ``exact_labels``: their label cap."""
 
     def __init__(self, search: "Search", bidirectional: bool | None, ng_columns: bool,
-                 keep: float):
+                 keep: float, exact_labels: int = 2_000_000):
         self.search = search
         self.bidirectional = bidirectional
         self.ng_columns = ng_columns
         self.keep = keep
+        self.exact_labels = exact_labels
         self.last_exact_labels = None  # sizes the next exact call's dominance layout
 
     def price(self, cost, ret, prof, allowed, *, heuristic: bool, y0: float, sig,
@@ -37,7 +38,7 @@ class Pricer:
         # an exact call makes about as many labels as the one before it: its sub-buckets follow
         nsub = None if heuristic else sub_buckets(cost.shape[0], self.last_exact_labels)
         res = price(cost, ret, prof, s.budget, s.ng, allowed, heuristic=heuristic,
-                    max_labels=200_000 if heuristic else 2_000_000,
+                    max_labels=200_000 if heuristic else self.exact_labels,
                     n_cols=30 if heuristic else 60, min_gain=y0 + TOL,
                     deadline=s.deadline if deadline is None else deadline,
                     bidirectional=bool(self.bidirectional) and not heuristic,

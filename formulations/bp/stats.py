@@ -31,6 +31,8 @@ class Stats:
     primal_error: str | None = None
     cuts: int = 0
     cuts_purged: int = 0
+    cuts_withdrawn: int = 0  # removed because an exact pricing under them hit its label cap
+    label_caps: int = 0  # exact pricings that hit their label cap (no bound from them)
     arcs_eliminated: int = 0  # arcs no plan better than the incumbent can use
     elim_s: float = 0.0  # time spent on their bounds
     elim_labels: bool | None = None  # the labelling bound ran to the end (None: not tried)
@@ -63,6 +65,7 @@ class Stats:
             "strong_s": round(self.strong_s, 3), "group_branches": self.group_branches,
             "open_nodes": self.open_nodes,
             "cuts": self.cuts, "cuts_purged": self.cuts_purged,
+            "cuts_withdrawn": self.cuts_withdrawn, "label_caps": self.label_caps,
             "arcs_eliminated": self.arcs_eliminated, "elim_s": round(self.elim_s, 3),
             "elim_labels": self.elim_labels, "pool_routes": self.pool_routes,
             "enum_tries": self.enum_tries, "enum_labels": self.enum_labels,

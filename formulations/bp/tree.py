@@ -49,7 +49,7 @@ class BranchAndPrice:
         def share(f: float) -> float:  # seconds for a root dive, the labelling arc bounds
             return f * s.limit if math.isfinite(s.limit) else 30.0
 
-        self.pricer = Pricer(s, opts.bidirectional, opts.ng_columns, opts.exact_keep)
+        self.pricer = Pricer(s, opts.bidirectional, opts.ng_columns, opts.exact_keep, opts.exact_labels)
         self.elimination = Elimination(s, elim_limit=share(opts.elim_share),
                                        pool_routes=opts.pool_routes)
         self.incumbents = IncumbentSearch(
@@ -140,10 +140,13 @@ class BranchAndPrice:
                     last_milp_cols = m.n_routes
             else:
                 bound, x, xa, converged = self.colgen.solve(state, parent_bound)
-            if not converged:
+            if not converged and s.time_left() <= 0:
                 heapq.heappush(heap, self._node_key(bound, state.depth, counter, state))
                 counter += 1
                 break
+            # not converged with time left: an exact pricing hit its label cap. The node's
+            # bound (its parent's, or one certified before the cap) still holds, so it is
+            # branched on its current LP: the children's pricing graphs are smaller
             if s.prunable(bound):
                 continue
             if s.stats.nodes % opts.dive_every == 0 and s.time_left() > 0:
