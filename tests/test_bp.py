@@ -1051,6 +1051,22 @@ def test_label_cap_without_cuts_branches_instead_of_stopping():
         assert _prize(inst, r) == pytest.approx(OPTIMAL["p2.2.k"])
 
 
+def test_a_root_slow_to_settle_calls_the_heuristic_before_its_first_dive():
+    """When the root's bound is not settled by primal_late_share of the limit (here 0: at once),
+    the caller's heuristic runs before the first dive instead of waiting for it; by default
+    (0.5) a root that settles early calls it only after its first dive. Both prove p2.2.k."""
+    from sarcover.formulations.bp.tree import BranchAndPrice
+
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    for share, first_after_dive in [(0.0, False), (0.5, True)]:
+        seen = []
+        bp = BranchAndPrice(inst, time_limit=60, primal=lambda seconds: seen.append(bp.incumbents.dived),
+                            options=BPOptions(primal_late_share=share, cut_rounds=0))
+        proven, bound = bp.run()
+        assert proven and bound == pytest.approx(OPTIMAL["p2.2.k"])
+        assert seen[:1] == [first_after_dive] or (first_after_dive and not seen)
+
+
 def test_purging_cuts_keeps_the_published_optimum():
     """Rounds of 48 cuts on p2.2.k pass the 64-cut limit, so idle cuts are purged between
     rounds; the published optimum is still proven."""

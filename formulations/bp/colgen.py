@@ -90,6 +90,10 @@ class ColumnGeneration:
                 continue
             if s.time_left() <= 0:
                 return bound, x, xa, False
+            if (state.depth == 0 and not s.stats.primal_calls and not self.incumbents.dived
+                    and time.perf_counter() > s.until(s.options.primal_late_share)
+                    and self.incumbents.call_primal()):
+                continue  # the root is slow to settle: a plan now, its routes in the LP
             gain = y0 + (self.slack(m.lagrangian_bound(y, y0)) if state.depth else 0.0)
             res = pricer.exact(cost, ret, prof, allowed, gain, sig)
             s.stats.exact_pricings += 1

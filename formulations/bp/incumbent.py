@@ -90,7 +90,8 @@ class IncumbentSearch:
         bound is settled and the first dive has not found a plan that proves it, so instances the
         root or its first dive settle (most TOP instances) never pay for it; and again after the
         root's cut rounds and last dive while the proof is still open, up to ``primal_calls``
-        calls in all (a heuristic may return another plan when called again: the registered bp's
+        calls in all; the first one earlier if the root's bound is not settled by
+        ``primal_late_share`` of the limit (a heuristic may return another plan when called again: the registered bp's
         PyVRP then searches with a new seed until its time is up)."""
         s = self.search
         if self.primal is None or s.time_left() <= 0 or s.stats.primal_calls >= s.options.primal_calls:

@@ -77,6 +77,11 @@ class BPOptions:
       one if the root and its first dive leave the proof open, the others one after the other
       while the root's cut rounds and last dive still do (each with a new seed, for the
       registered bp's PyVRP); None: by the time limit (:func:`default_primal_calls`).
+    - ``primal_late_share``: if the root's bound is still not settled when this share of the
+      limit is used up, the first call runs then (its routes also join the LP): on TOP set 4's
+      two-vehicle files the root's column generation can take the whole limit, and without the
+      heuristic the plan is only what the MILP over the generated routes finds (p4.2.r: 1115
+      against a best known 1292).
     - ``primal_share``, ``primal_cap_s``: time for each call of the caller's ``primal``
       heuristic, at most ``primal_cap_s`` seconds. 30 s: on
       M = 20, K = 5-6 a 30 s PyVRP search found plans one better than bp's (10 s) on about a
@@ -121,6 +126,7 @@ class BPOptions:
     cut_share: float = 0.35
     primal_calls: int | None = None
     primal_share: float = 0.1
+    primal_late_share: float = 0.5
     primal_cap_s: float = 30.0
     dive_share: float = 0.1
     dive_every: int = 4
