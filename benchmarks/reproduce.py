@@ -23,14 +23,14 @@ paper-opt         2.1 h     the paper's grid (Fig. 3 and 4 settings, 20 instance
 decomposition     ~12 min   clustering / cross-cluster / routing loss of the paper methods, from
                             paper-opt's optima, at N=5 K=3, N=5 K=6 and K=3 N=2..6 (one instance per
                             worker; 755 of its 960 rows took 9.3 min on 2)
-top-4-7           ~5-8 h    bp alone at 600 s on the 192 shipped files of TOP sets 4-7 (~10-15 CPU-hours)
+top-4-7           2.6 h     bp alone at 600 s on the 192 shipped files of TOP sets 4-7 (5.2 CPU-hours)
 ================  ========  =========================================================================
 
 ``--runs R`` sets the random instances per setting of paper-n and paper-k (the paper: 1000, the
 default); ``--skip STEP`` leaves a suite or the decomposition out; ``--report-only`` only rewrites
 the report. Every step resumes: a stopped run continues where it stopped. The results directory
-(raw JSON Lines rows) is not committed; the report's CSVs are (top-4-7's first 165 files, too long
-for one sitting, keep their raw rows in ``reports/top-4-7/rows/`` to resume from).
+(raw JSON Lines rows) is not committed; the report's CSVs are (top-4-7, run in two sittings, also
+keeps its raw rows in ``reports/top-4-7/rows/``).
 """
 
 from __future__ import annotations
