@@ -101,8 +101,9 @@ def _finish(bench, tmp_path, marks):
         rows = (tmp_path / "res" / "results.jsonl")
         stored = len(rows.read_text().splitlines()) if rows.exists() else 0
         log = (marks.parent / "cluster.log").read_text().splitlines()
-        raise AssertionError(f"the bench run did not end in 180 s ({stored} rows stored); its stderr:\n{stderr}\n"
-                             "the cluster's log, last 40 lines:\n" + "\n".join(log[-40:])) from None
+        raise AssertionError(f"the bench run did not end in 180 s ({stored} rows stored); its "
+                             f"stderr:\n{stderr}\nthe cluster's log, last 40 lines:\n"
+                             + "\n".join(log[-40:])) from None
     finally:
         _stop(bench)
     assert bench.returncode == 0, stderr

@@ -91,8 +91,8 @@ class IncumbentSearch:
         root or its first dive settle (most TOP instances) never pay for it; and again after the
         root's cut rounds and last dive while the proof is still open, up to ``primal_calls``
         calls in all; the first one earlier if the root's bound is not settled by
-        ``primal_late_share`` of the limit (a heuristic may return another plan when called again: the registered bp's
-        PyVRP then searches with a new seed until its time is up)."""
+        ``primal_late_share`` of the limit (a heuristic may return another plan when called
+        again: the registered bp's PyVRP then searches with a new seed until its time is up)."""
         s = self.search
         if self.primal is None or s.time_left() <= 0 or s.stats.primal_calls >= s.options.primal_calls:
             return False
