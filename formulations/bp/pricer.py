@@ -20,7 +20,7 @@ class Pricer:
     (:func:`.pricing.price`); ``exact_labels``: their label cap."""
 
     def __init__(self, search: "Search", bidirectional: bool | None, ng_columns: bool,
-                 keep: float, exact_labels: int = 2_000_000):
+                 keep: float, exact_labels: int):
         self.search = search
         self.bidirectional = bidirectional
         self.ng_columns = ng_columns

@@ -49,7 +49,8 @@ class BranchAndPrice:
         def share(f: float) -> float:  # seconds for a root dive, the labelling arc bounds
             return f * s.limit if math.isfinite(s.limit) else 30.0
 
-        self.pricer = Pricer(s, opts.bidirectional, opts.ng_columns, opts.exact_keep, opts.exact_labels)
+        self.pricer = Pricer(s, opts.bidirectional, opts.ng_columns, opts.exact_keep,
+                             opts.exact_labels)
         self.elimination = Elimination(s, elim_limit=share(opts.elim_share),
                                        pool_routes=opts.pool_routes)
         self.incumbents = IncumbentSearch(
