@@ -29,14 +29,19 @@ top-4-7           2.6 h     bp alone at 600 s on the 192 shipped files of TOP se
 ``--runs R`` sets the random instances per setting of paper-n and paper-k (the paper: 1000, the
 default); ``--skip STEP`` leaves a suite or the decomposition out; ``--report-only`` only rewrites
 the report. Every step resumes: a stopped run continues where it stopped. The results directory
-(raw JSON Lines rows) is not committed; the report's CSVs are (top-4-7, run in two sittings, also
-keeps its raw rows in ``reports/top-4-7/rows/``).
+(raw JSON Lines rows) is not committed; the report's CSVs are. The raw rows of the long steps
+(paper-opt, the decomposition, top-4-7) are committed too, in ``reports/reference/rows/<step>/``, so
+that a reference run spread over several sittings on fresh machines loses none of them:
+``--resume-from reports/reference/rows`` first copies each step's stored rows into the results
+root, where the root holds nothing for that step yet (it never merges into rows already there);
+each step then runs only the jobs those rows lack (with ``--report-only``, none).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -67,14 +72,33 @@ def decompose_step(root: Path, *, quiet: bool = False, workers: int | None = Non
     return len(rows)
 
 
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line naming the problem, exit 2, no usage dump
+        self.exit(2, f"{self.prog}: {message}\n")
+
+
+def seed_step(rows: Path, root: Path, step: str) -> bool:
+    """Copy ``rows/<step>/`` (a results folder of that step) to ``root/<step>/`` if the first exists
+    and the second does not; returns whether it copied. Rows already in ``root`` are never touched."""
+    src, dst = rows / step, root / step
+    if not src.is_dir() or dst.exists():
+        return False
+    root.mkdir(parents=True, exist_ok=True)
+    shutil.copytree(src, dst)
+    return True
+
+
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m sarcover.benchmarks.reproduce", description=__doc__.splitlines()[0])
+    ap = _Parser(prog="python -m sarcover.benchmarks.reproduce", description=__doc__.splitlines()[0])
     ap.add_argument("--results", default="results/reference", help="results root (default results/reference)")
     ap.add_argument("--out", default="reports/reference", help="report directory (default reports/reference)")
     ap.add_argument("--runs", type=int, default=1000, help="instances per setting of paper-n/paper-k (default 1000)")
     ap.add_argument("--workers", type=int, help="worker processes (default: all cores)")
     ap.add_argument("--skip", action="append", default=[], choices=STEPS,
                     help="leave a suite or the decomposition out (repeatable)")
+    ap.add_argument("--resume-from", metavar="ROWS",
+                    help="first copy ROWS/<step>/ (stored raw rows, e.g. reports/reference/rows) into the "
+                         "results root for every step the root has nothing for")
     ap.add_argument("--report-only", action="store_true", help="do not run; rewrite the report from stored results")
     ap.add_argument("--quiet", action="store_true", help="no progress bars")
     ap.add_argument("--note", action="append", default=[], help="a paragraph to add to the report (repeatable)")
@@ -85,6 +109,13 @@ def main(argv: list[str] | None = None) -> int:
     from sarcover.reports.reference import write_reference
 
     root = Path(args.results)
+    seed = Path(args.resume_from) if args.resume_from else None
+    if seed is not None:
+        if not seed.is_dir():
+            ap.error(f"--resume-from: {seed} is not a directory")
+        for name in STEPS:
+            if name not in args.skip and seed_step(seed, root, name):
+                print(f"{name}: copied the stored rows of {seed / name} into {root / name}", file=sys.stderr)
     if not args.report_only:
         for name in STEPS:
             if name in args.skip:

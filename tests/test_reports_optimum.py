@@ -248,3 +248,32 @@ def test_reproduce_runs_paper_opt_then_decomposition_then_top_4_7(tmp_path, monk
     assert set(DECOMPOSE_SETTINGS) >= {(3, 2), (3, 5), (6, 5)}
     assert seen["out"] == tmp_path / "decomposition" / "rows.jsonl"
     assert [s.x for s in SWEEPS] == ["N", "K"]
+
+
+def test_reproduce_resumes_from_committed_rows(tmp_path, capsys):
+    """--resume-from copies each step's stored rows into a results root that has none for it (never
+    over rows already there), so the committed top-4-7 rows give the report's TOP 4-7 section."""
+    from pathlib import Path
+
+    from sarcover.benchmarks import reproduce
+
+    committed = Path(reproduce.__file__).resolve().parents[1] / "reports" / "reference" / "rows"
+    assert (committed / "top-4-7" / "results.jsonl").is_file()
+    root, out = tmp_path / "results", tmp_path / "out"
+    assert reproduce.main(["--results", str(root), "--out", str(out), "--report-only", "--quiet",
+                           "--resume-from", str(committed)]) == 0
+    stored = (root / "top-4-7" / "results.jsonl").read_text()
+    assert stored == (committed / "top-4-7" / "results.jsonl").read_text() and stored.count("\n") == 192
+    assert "## bp on the larger TOP sets" in (out / "README.md").read_text()
+    assert not reproduce.seed_step(committed, root, "paper-n")  # nothing stored for it
+    # a step the results root already has rows for is left as it is
+    other = tmp_path / "other"
+    write_rows(other / "top-4-7", [json.loads(line) for line in stored.splitlines()[:10]])
+    assert not reproduce.seed_step(committed, other, "top-4-7")
+    assert (other / "top-4-7" / "results.jsonl").read_text().count("\n") == 10
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as exc:
+        reproduce.main(["--resume-from", str(tmp_path / "missing"), "--report-only"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--resume-from" in err and "missing" in err
