@@ -13,7 +13,7 @@ import pytest
 
 from sarcover.benchmarks.registry import run_method
 from sarcover.formulations.bp import BPOptions, solve_bp
-from sarcover.formulations.bp.options import CUTS_FROM_S, MORE_PRIMAL_FROM_S, OPEN_CUTS_FROM_S
+from sarcover.formulations.bp.options import CUTS_FROM_S, ENUM_FROM_S, MORE_PRIMAL_FROM_S, OPEN_CUTS_FROM_S
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.io import load_instance
 from sarcover.formulations.plan import Plan
@@ -1134,12 +1134,13 @@ def test_cuts_match_brute_force(seed):
 
 
 @pytest.mark.parametrize("offset", [0.0, -1.0])
-@pytest.mark.parametrize("threshold", ["CUTS_FROM_S", "OPEN_CUTS_FROM_S", "MORE_PRIMAL_FROM_S"])
+@pytest.mark.parametrize("threshold", ["CUTS_FROM_S", "OPEN_CUTS_FROM_S", "MORE_PRIMAL_FROM_S", "ENUM_FROM_S"])
 def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, threshold):
     """The registered bp spends a moment on greedy before solve_bp; whether cuts are on, how
-    open their gate is and how often the primal heuristic runs follow the user's time limit (at
-    CUTS_FROM_S: on; at OPEN_CUTS_FROM_S: open; at MORE_PRIMAL_FROM_S: 4 calls), not the
-    slightly smaller one left for solve_bp."""
+    open their gate is, how often the primal heuristic runs and whether route enumeration is on
+    follow the user's time limit (at CUTS_FROM_S: on; at OPEN_CUTS_FROM_S: open; at
+    MORE_PRIMAL_FROM_S: 4 calls; at ENUM_FROM_S: on), not the slightly smaller one left for
+    solve_bp."""
     import sarcover.formulations.bp as bp_package
     import sarcover.formulations.bp.options as bp_options
     from sarcover.benchmarks.registry import METHODS
@@ -1160,6 +1161,20 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, thre
     assert seen["options"].cut_rounds == default_cut_rounds(limit) == (6 if limit >= CUTS_FROM_S else 0)
     assert seen["options"].cut_gap == default_cut_gap(limit) == (1.0 if limit >= OPEN_CUTS_FROM_S else 0.5)
     assert seen["options"].primal_calls == (4 if limit >= MORE_PRIMAL_FROM_S else 2)
+    assert seen["options"].enum_share == (0.6 if limit >= ENUM_FROM_S else 0.0)
+
+
+def test_enumeration_is_on_by_default_for_long_runs_only():
+    """Route enumeration after the root: by default from ENUM_FROM_S seconds (and without a
+    limit); an explicit enum_share wins either way."""
+    from sarcover.formulations.bp.tree import BranchAndPrice
+
+    inst = random_tiny(0, groups=False)
+    assert BranchAndPrice(inst, time_limit=ENUM_FROM_S - 1).enumeration is None
+    assert BranchAndPrice(inst, time_limit=ENUM_FROM_S).enumeration is not None
+    assert BranchAndPrice(inst, time_limit=None).enumeration is not None
+    assert BranchAndPrice(inst, time_limit=None, options=BPOptions(enum_share=0)).enumeration is None
+    assert BranchAndPrice(inst, time_limit=10, options=BPOptions(enum_share=0.5)).enumeration is not None
 
 
 def test_cuts_are_on_by_default_for_long_runs_only():
@@ -1199,7 +1214,9 @@ def test_options_for_time_limit(limit):
     on, open_gate = limit is None or limit >= CUTS_FROM_S, limit is None or limit >= OPEN_CUTS_FROM_S
     assert opts.cut_rounds == (6 if on else 0) and opts.cut_gap == (1.0 if open_gate else 0.5)
     assert opts.primal_calls == (4 if limit is None or limit >= MORE_PRIMAL_FROM_S else 2)
-    assert dataclasses.replace(opts, cut_rounds=None, cut_gap=None, primal_calls=None) == BPOptions()
+    assert opts.enum_share == (0.6 if limit is None or limit >= ENUM_FROM_S else 0.0)
+    assert dataclasses.replace(opts, cut_rounds=None, cut_gap=None, primal_calls=None,
+                               enum_share=None) == BPOptions()
     assert BPOptions().with_limit_defaults(limit) == opts
     assert BPOptions(cut_rounds=2, strong=1).with_limit_defaults(limit).cut_rounds == 2
     with pytest.raises(dataclasses.FrozenInstanceError):

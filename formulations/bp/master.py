@@ -75,6 +75,44 @@ def _lm_coefficient(route, S, memory) -> int:
     return pairs
 
 
+def violated_triples(vis: np.ndarray, xp: np.ndarray, have, min_violation: float) -> list:
+    """Triples S of points (columns of ``vis``) whose subset-row cut sum_r floor(a_Sr / 2) x_r
+    <= 1 the LP solution violates by more than ``min_violation``, most violated first.
+    ``vis``: (routes, points) visits of the routes with x > 0 (points that no cut may hold, such
+    as start and end, at 0), ``xp`` their LP values; ``have``: triples to leave out."""
+    pts = np.flatnonzero(vis.sum(axis=0) > 0)
+    found = []
+    for a_i, a in enumerate(pts):
+        for b_i in range(a_i + 1, len(pts)):
+            b = pts[b_i]
+            ab = vis[:, a] + vis[:, b]
+            rest = pts[b_i + 1 :]
+            if rest.size == 0 or not np.any(ab):
+                continue
+            lhs = ((ab[:, None] + vis[:, rest]) // 2 * xp[:, None]).sum(axis=0)
+            for c in np.flatnonzero(lhs > 1.0 + min_violation):
+                S = (int(a), int(b), int(rest[c]))
+                if S not in have:
+                    found.append((float(lhs[c]), S))
+    found.sort(key=lambda t: -t[0])
+    return [S for _, S in found]
+
+
+def spread(triples, room: int, per_point: int = 3) -> list:
+    """Up to ``room`` of ``triples`` in order, a point in at most ``per_point`` of them (cuts on
+    the same few points overlap and lower the LP less)."""
+    chosen, used = [], {}
+    for S in triples:
+        if any(used.get(p, 0) >= per_point for p in S):
+            continue
+        chosen.append(S)
+        for p in S:
+            used[p] = used.get(p, 0) + 1
+        if len(chosen) >= room:
+            break
+    return chosen
+
+
 class Master:
     def __init__(self, n_nodes: int, prizes: np.ndarray, groups, n_vehicles: int):
         self.V = n_nodes
@@ -218,36 +256,9 @@ class Master:
         if room <= 0 or pos.size == 0:
             return []
         vis = self._visit[pos].astype(np.int64)  # (routes, points)
-        xp = x[pos]
-        pts = np.flatnonzero(vis.sum(axis=0) > 0)
-        pts = pts[(pts > 0) & (pts <= self.V)]
-        have = set(self.cuts)
-        found = []
-        for a_i, a in enumerate(pts):
-            for b_i in range(a_i + 1, len(pts)):
-                b = pts[b_i]
-                ab = vis[:, a] + vis[:, b]
-                if not np.any(ab):
-                    continue
-                rest = pts[b_i + 1 :]
-                if rest.size == 0:
-                    continue
-                lhs = ((ab[:, None] + vis[:, rest]) // 2 * xp[:, None]).sum(axis=0)
-                for c in np.flatnonzero(lhs > 1.0 + min_violation):
-                    S = (int(a), int(b), int(rest[c]))
-                    if S not in have:
-                        found.append((float(lhs[c]), S))
-        found.sort(key=lambda t: -t[0])
-        chosen, used = [], {}
-        for _, S in found:  # spread the new cuts: a point in at most 3 of them per round
-            if any(used.get(p, 0) >= 3 for p in S):
-                continue
-            chosen.append((S, self._memory(S, x)))
-            for p in S:
-                used[p] = used.get(p, 0) + 1
-            if len(chosen) >= room:
-                break
-        return chosen
+        vis[:, 0] = vis[:, self.V + 1] = 0
+        found = violated_triples(vis, x[pos], set(self.cuts), min_violation)
+        return [(S, self._memory(S, x)) for S in spread(found, room)]
 
     def add_cuts(self, cuts) -> int:
         """Add subset-row cut rows ((triple, memory) of solver points) over all generated routes."""

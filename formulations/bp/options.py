@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 CUTS_FROM_S = 60.0  # time limits from which subset-row cuts are on by default
 OPEN_CUTS_FROM_S = 300.0  # ... and from which they are tried however far the LP is from a drop
 MORE_PRIMAL_FROM_S = 600.0  # time limits from which the root calls the primal heuristic 4 times
+ENUM_FROM_S = 300.0  # time limits from which route enumeration is on by default
 
 
 def default_cut_rounds(time_limit: float | None) -> int:
@@ -28,6 +29,13 @@ def default_primal_calls(time_limit: float | None) -> int:
     open): 2, and 4 from ``MORE_PRIMAL_FROM_S`` (and without a limit), where the two extra
     searches take a small share of the limit from the tree (docs/bp.md)."""
     return 4 if time_limit is None or float(time_limit) >= MORE_PRIMAL_FROM_S else 2
+
+
+def default_enum_share(time_limit: float | None) -> float:
+    """Share of the limit for one route enumeration try by default: 0.6 from ``ENUM_FROM_S``
+    (and without a limit, where a try gets 30 s), else 0 (off): the root alone takes about a
+    third of 300 s on M = 20, K = 5, and a complete listing up to another third (docs/bp.md)."""
+    return 0.6 if time_limit is None or float(time_limit) >= ENUM_FROM_S else 0.0
 
 
 def default_cut_gap(time_limit: float | None) -> float:
@@ -102,15 +110,19 @@ class BPOptions:
     - ``pool_routes``: best elementary routes of that labelling that join the master as columns
       (for the MILP over the generated routes).
 
-    Route enumeration (:mod:`.enumeration`):
+    Route enumeration (:mod:`.enumeration`), tried after the root once its certificate leaves
+    the incumbent one step from a proof:
 
-    - ``enum_share``: seconds for one try (listing the routes a better plan may use under the
-      root certificate, then the MILP over them), as a share of the limit (30 s without one);
-      0 (the default) turns enumeration off: on the M = 20, K = 4-6 instances the windows
-      left by the root are too wide for it (docs/bp.md).
-    - ``enum_gap``: only tried while the root certificate's bound is at most this many prize
-      steps above the incumbent + one step.
-    - ``enum_labels``, ``enum_routes``: a try gives up beyond this many labels or routes.
+    - ``enum_share``: seconds for one try (listing the routes, the LP over them with its cuts,
+      the MILP over the routes left), as a share of the limit (30 s without one); 0 turns
+      enumeration off. None: 0.6 from ``ENUM_FROM_S`` (300 s), else 0.
+    - ``enum_gap``: the listing is complete (its outcome a proof) while the root certificate's
+      bound is at most this many prize steps above the incumbent + one step; the number of
+      routes to list grows about tenfold per 0.1 step (docs/bp.md).
+    - ``enum_primal_window``: above ``enum_gap``, list only the routes within this many prize
+      steps of the best and search them for a better plan (no proof); 0: no such try.
+    - ``enum_labels``, ``enum_routes``: a try gives up beyond this many labels (about 70 bytes
+      each) or routes.
     """
 
     ng_size: int = 8
@@ -135,25 +147,29 @@ class BPOptions:
     group_branching: bool = False
     elim_share: float = 0.1
     pool_routes: int = 2000
-    enum_share: float = 0.0
+    enum_share: float | None = None
     enum_gap: float = 0.3
-    enum_labels: int = 4_000_000
-    enum_routes: int = 300_000
+    enum_primal_window: float = 0.2
+    enum_labels: int = 30_000_000
+    enum_routes: int = 3_000_000
 
     @classmethod
     def for_time_limit(cls, time_limit: float | None) -> "BPOptions":
         """The default options for a run whose user asked for ``time_limit`` seconds (None: no
-        limit): cuts on from ``CUTS_FROM_S``, their gate open from ``OPEN_CUTS_FROM_S``."""
+        limit): cuts on from ``CUTS_FROM_S``, their gate open from ``OPEN_CUTS_FROM_S``, route
+        enumeration on from ``ENUM_FROM_S``."""
         return cls().with_limit_defaults(time_limit)
 
     def with_limit_defaults(self, time_limit: float | None) -> "BPOptions":
         """These options with the settings left None (``cut_rounds``, ``cut_gap``,
-        ``primal_calls``) decided on ``time_limit``."""
+        ``primal_calls``, ``enum_share``) decided on ``time_limit``."""
         return replace(
             self,
             cut_rounds=(default_cut_rounds(time_limit) if self.cut_rounds is None
                         else self.cut_rounds),
             cut_gap=default_cut_gap(time_limit) if self.cut_gap is None else self.cut_gap,
             primal_calls=(default_primal_calls(time_limit) if self.primal_calls is None
-                          else self.primal_calls))
+                          else self.primal_calls),
+            enum_share=(default_enum_share(time_limit) if self.enum_share is None
+                        else self.enum_share))
 

@@ -986,7 +986,9 @@ def warm_up() -> None:
                   max_labels=100, n_cols=1, min_gain=0.5, bidirectional=bi)
     arc_bounds(cost, prof, allowed, 4.0)  # the arc elimination's bounds
     label_arc_bounds(cost, prof, allowed, 4.0, full_ng(3), -1.0, n_routes=1)
+    from sarcover.formulations.bp.enumerated_lp import warm_up as enumerated_lp_warm_up
     from sarcover.formulations.bp.enumeration import warm_up as enumeration_warm_up
 
     enumeration_warm_up()  # the route enumeration's kernel
+    enumerated_lp_warm_up()  # the cut coefficients over the enumerated routes
     _WARM = True

@@ -38,9 +38,15 @@ class Stats:
     elim_labels: bool | None = None  # the labelling bound ran to the end (None: not tried)
     pool_routes: int = 0  # routes its search added to the master
     enum_tries: int = 0  # route enumerations tried (closing the root gap)
+    enum_complete: int = 0  # of them, complete listings (the others list a narrower window)
+    enum_improved: int = 0  # tries whose MILP raised the incumbent
     enum_labels: int | None = None  # labels and routes of the last one (routes None: capped)
     enum_routes: int | None = None
     enum_s: float = 0.0
+    enum_lp_s: float = 0.0  # the LP over the enumerated routes, its cut rounds and filter
+    enum_lp_bound: float | None = None  # its last bound
+    enum_cuts: int = 0  # full-memory triples it added
+    enum_left: int | None = None  # routes left after its reduced-cost filter
     enum_milp_s: float = 0.0  # the MILP over the enumerated routes
     enum_status: str | None = None  # its outcome: optimal, infeasible (proof) or open
     root_lp: float | None = None  # restricted root LP value when cuts were first considered
@@ -68,8 +74,11 @@ class Stats:
             "cuts_withdrawn": self.cuts_withdrawn, "label_caps": self.label_caps,
             "arcs_eliminated": self.arcs_eliminated, "elim_s": round(self.elim_s, 3),
             "elim_labels": self.elim_labels, "pool_routes": self.pool_routes,
-            "enum_tries": self.enum_tries, "enum_labels": self.enum_labels,
+            "enum_tries": self.enum_tries, "enum_complete": self.enum_complete,
+            "enum_improved": self.enum_improved, "enum_labels": self.enum_labels,
             "enum_routes": self.enum_routes, "enum_s": round(self.enum_s, 3),
+            "enum_lp_s": round(self.enum_lp_s, 3), "enum_lp_bound": self.enum_lp_bound,
+            "enum_cuts": self.enum_cuts, "enum_left": self.enum_left,
             "enum_milp_s": round(self.enum_milp_s, 3), "enum_status": self.enum_status,
             "root_lp": self.root_lp, "primal_calls": self.primal_calls,
             "primal_s": self.primal_s, "primal_prize": self.primal_prize,

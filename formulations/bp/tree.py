@@ -61,7 +61,8 @@ class BranchAndPrice:
                               until=s.until(opts.cut_share))
         self.enumeration = (Enumeration(s, self.elimination, self.incumbents,
                                         limit=share(opts.enum_share), gap=opts.enum_gap,
-                                        max_labels=opts.enum_labels, max_routes=opts.enum_routes)
+                                        max_labels=opts.enum_labels, max_routes=opts.enum_routes,
+                                        primal_window=opts.enum_primal_window)
                             if opts.enum_share > 0 else None)
         self.colgen = ColumnGeneration(s, self.pricer, self.elimination, self.incumbents,
                                        self.cuts, ng_cap=opts.ng_cap,
