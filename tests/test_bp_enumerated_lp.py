@@ -99,3 +99,25 @@ def test_bp_with_enumeration_proves_the_optimum(seed):
     assert plain.status == enum.status == Status.OPTIMAL
     assert verify(inst, enum.plan).valid
     assert verify(inst, enum.plan).prize == pytest.approx(verify(inst, plain.plan).prize)
+
+
+@pytest.mark.parametrize("where", ["enumerate_routes", "EnumeratedLP"])
+def test_enumeration_out_of_memory_gives_up_the_try(monkeypatch, where):
+    """A MemoryError in the listing or in the LP over it (a process memory limit below what the
+    label cap allows) ends that try, counted in info; the tree still proves the optimum."""
+    from pathlib import Path
+
+    from sarcover.formulations.bp import enumeration
+    from sarcover.formulations.io import load_instance
+
+    def out_of_memory(*args, **kwargs):
+        raise MemoryError
+
+    inst = load_instance(Path(__file__).resolve().parents[1] / "benchmarks/instances/top/p2.2.k.txt")
+    tried = solve_bp(inst, time_limit=60, options=BPOptions(enum_share=0.5, enum_gap=1.0))
+    assert tried.info["enum_tries"] == 1 and tried.info["enum_status"] == "infeasible"  # the try closes it
+    monkeypatch.setattr(enumeration, where, out_of_memory)
+    res = solve_bp(inst, time_limit=60, options=BPOptions(enum_share=0.5, enum_gap=1.0))
+    assert res.info["enum_memory"] == 1 and res.info["enum_status"] is None
+    assert res.status == Status.OPTIMAL
+    assert verify(inst, res.plan).prize == pytest.approx(verify(inst, tried.plan).prize)

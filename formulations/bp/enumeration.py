@@ -430,11 +430,17 @@ class Enumeration:
         sig = np.zeros(len(m.cuts))
         cut = np.maximum(y[m.base_rows :], 0.0)[: len(m.cuts)]
         sig[: cut.size] = cut
-        res = enumerate_routes(cost, m.point_profit(y), allowed, s.budget, y[0] + floor,
-                               ng=s.ng, cut_members=m.cut_members, cut_memory=m.cut_memory,
-                               cut_duals=sig, max_labels=self.max_labels,
-                               max_routes=self.max_routes, deadline=deadline)
         st = s.stats
+        try:
+            res = enumerate_routes(cost, m.point_profit(y), allowed, s.budget, y[0] + floor,
+                                   ng=s.ng, cut_members=m.cut_members, cut_memory=m.cut_memory,
+                                   cut_duals=sig, max_labels=self.max_labels,
+                                   max_routes=self.max_routes, deadline=deadline)
+        except MemoryError:  # a process memory limit below what the label cap allows
+            st.enum_tries += 1
+            st.enum_memory += 1
+            st.enum_s += time.perf_counter() - t
+            return False
         st.enum_tries += 1
         st.enum_complete += complete
         st.enum_labels = res.n_labels
@@ -443,10 +449,15 @@ class Enumeration:
         if res.paths is None:
             return False
         need = s.incumbent_value + (s.step if s.integral else 1e-9)
-        lp = EnumeratedLP(m, res.paths, cuts=zip(m.cuts, m.memories))
         t = time.perf_counter()
-        none_listed = self._tighten(lp, need, y, deadline)
-        st.enum_lp_s += time.perf_counter() - t
+        try:
+            lp = EnumeratedLP(m, res.paths, cuts=zip(m.cuts, m.memories))
+            none_listed = self._tighten(lp, need, y, deadline)
+        except MemoryError:
+            st.enum_memory += 1
+            return False
+        finally:
+            st.enum_lp_s += time.perf_counter() - t
         st.enum_left = len(lp)
         if none_listed:  # no plan worth need among the listed routes
             st.enum_status = "infeasible"

@@ -121,8 +121,9 @@ class BPOptions:
       routes to list grows about tenfold per 0.1 step (docs/bp.md).
     - ``enum_primal_window``: above ``enum_gap``, list only the routes within this many prize
       steps of the best and search them for a better plan (no proof); 0: no such try.
-    - ``enum_labels``, ``enum_routes``: a try gives up beyond this many labels (about 70 bytes
-      each) or routes.
+    - ``enum_labels``, ``enum_routes``: a try gives up beyond this many labels or routes. The
+      labels take about 70 bytes each, so 2^24 (16.8 M) stay near 1.2 GB, within the
+      harness's 4 GB per worker; a try that still runs out of memory gives up as well.
     """
 
     ng_size: int = 8
@@ -150,7 +151,7 @@ class BPOptions:
     enum_share: float | None = None
     enum_gap: float = 0.3
     enum_primal_window: float = 0.2
-    enum_labels: int = 30_000_000
+    enum_labels: int = 1 << 24
     enum_routes: int = 3_000_000
 
     @classmethod

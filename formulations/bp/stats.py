@@ -40,6 +40,7 @@ class Stats:
     enum_tries: int = 0  # route enumerations tried (closing the root gap)
     enum_complete: int = 0  # of them, complete listings (the others list a narrower window)
     enum_improved: int = 0  # tries whose MILP raised the incumbent
+    enum_memory: int = 0  # tries stopped by a MemoryError (a process memory limit)
     enum_labels: int | None = None  # labels and routes of the last one (routes None: capped)
     enum_routes: int | None = None
     enum_s: float = 0.0
@@ -75,7 +76,8 @@ class Stats:
             "arcs_eliminated": self.arcs_eliminated, "elim_s": round(self.elim_s, 3),
             "elim_labels": self.elim_labels, "pool_routes": self.pool_routes,
             "enum_tries": self.enum_tries, "enum_complete": self.enum_complete,
-            "enum_improved": self.enum_improved, "enum_labels": self.enum_labels,
+            "enum_improved": self.enum_improved, "enum_memory": self.enum_memory,
+            "enum_labels": self.enum_labels,
             "enum_routes": self.enum_routes, "enum_s": round(self.enum_s, 3),
             "enum_lp_s": round(self.enum_lp_s, 3), "enum_lp_bound": self.enum_lp_bound,
             "enum_cuts": self.enum_cuts, "enum_left": self.enum_left,
