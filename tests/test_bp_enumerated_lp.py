@@ -4,6 +4,8 @@ gap with it."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -121,3 +123,27 @@ def test_enumeration_out_of_memory_gives_up_the_try(monkeypatch, where):
     assert res.info["enum_memory"] == 1 and res.info["enum_status"] is None
     assert res.status == Status.OPTIMAL
     assert verify(inst, res.plan).prize == pytest.approx(verify(inst, tried.plan).prize)
+
+
+def test_narrow_tries_widen_until_complete(monkeypatch):
+    """Above enum_gap a try lists only the routes within enum_primal_window steps of the best;
+    when they hold no better plan the next try is WIDEN steps wider, and one as wide as the
+    window is complete and proves the optimum (WIDEN made large: the second try is complete)."""
+    from pathlib import Path
+
+    from sarcover.formulations.bp.enumeration import Enumeration
+    from sarcover.formulations.io import load_instance
+
+    inst = load_instance(Path(__file__).resolve().parents[1] / "benchmarks/instances/top/p2.2.k.txt")
+    opts = BPOptions(enum_share=0.5, enum_gap=0.0, enum_primal_window=1e-3)
+    narrow = solve_bp(inst, time_limit=60, options=opts)
+    assert narrow.info["enum_tries"] >= 2 and narrow.info["enum_complete"] == 0  # 0.1 wider each
+    monkeypatch.setattr(Enumeration, "WIDEN", 100.0)
+    res = solve_bp(inst, time_limit=60, options=opts)
+    assert (res.info["enum_tries"], res.info["enum_complete"]) == (2, 1)
+    assert res.status == Status.OPTIMAL and res.info["enum_status"] == "infeasible"
+    assert verify(inst, res.plan).prize == pytest.approx(verify(inst, narrow.plan).prize)
+    # a wider listing that would pass the label cap (ten times the narrow one's labels) is not tried
+    capped = solve_bp(inst, time_limit=60, options=dataclasses.replace(
+        opts, enum_labels=5 * narrow.info["enum_labels"]))
+    assert capped.info["enum_tries"] == 1 and capped.status == Status.OPTIMAL

@@ -374,10 +374,16 @@ class Enumeration:
     optimal); above it, only the routes within ``primal_window`` steps of the best are listed
     (the threshold raised by the difference), and the MILP over them can only find a better
     plan. The plan one step above the incumbent has a total slack of the window over its
-    routes, so most of its routes sit well inside a narrow window. ``primal_window`` 0 turns
-    that off. ``limit``: seconds per try; ``max_labels``, ``max_routes``: the caps beyond which
-    a listing gives up; ``milp_routes``: cut rounds stop once this few routes are left;
-    ``cuts_per_round``: triples per round."""
+    routes, so most of its routes sit well inside a narrow window. A narrow try that finds no
+    plan is followed by one ``WIDEN`` steps wider (with the same certificate and incumbent) if
+    its labels and routes, ``GROWTH`` times as many, stay within the caps; a try as wide as the
+    window is complete. ``primal_window`` 0 turns the narrow tries off. ``limit``: seconds per
+    try; ``max_labels``, ``max_routes``: the caps beyond which a listing gives up;
+    ``milp_routes``: cut rounds stop once this few routes are left; ``cuts_per_round``:
+    triples per round."""
+
+    WIDEN = 0.1  # steps added to a narrow window that listed no better plan
+    GROWTH = 10.0  # labels and routes per WIDEN more steps (measured on M = 20, K = 5, docs/bp.md)
 
     def __init__(self, search: "Search", elimination: "Elimination",
                  incumbents: "IncumbentSearch", *, limit: float, gap: float, max_labels: int,
@@ -394,16 +400,17 @@ class Enumeration:
         self.milp_routes = milp_routes
         self.cuts_per_round = cuts_per_round
         self._tried = None  # (certificate, incumbent value) of the last try
+        self._wider = None  # the next narrow window to try with them (None: nothing left)
 
     def window(self) -> float | None:
         """Certificate bound - incumbent - one step, in prize steps: the slack a plan one step
         better than the incumbent leaves its routes. None when there is nothing to try: no
-        certificate or incumbent, no time, no better plan possible, or tried already with this
-        certificate and incumbent."""
+        certificate or incumbent, no time, no better plan possible, or every try with this
+        certificate and incumbent done."""
         s, elim = self.search, self.elimination
         if elim.rc_floor() is None or s.time_left() <= 0:
             return None
-        if self._tried == (elim.cert, s.incumbent_value):
+        if self._tried == (elim.cert, s.incumbent_value) and self._wider is None:
             return None
         window = (elim.cert.bound - s.incumbent_value - s.step) / s.step
         if window < 0 or (window > self.gap and self.primal_window <= 0):
@@ -417,12 +424,13 @@ class Enumeration:
         window = self.window()
         if window is None:
             return False
-        complete = window <= self.gap
         cert = elim.cert
-        self._tried = (cert, s.incumbent_value)
+        width = self.primal_window if self._tried != (cert, s.incumbent_value) else self._wider
+        complete = window <= max(self.gap, width)
+        self._tried, self._wider = (cert, s.incumbent_value), None
         floor = elim.rc_floor()
-        if not complete:  # only the routes within primal_window steps of the best
-            floor += (window - self.primal_window) * s.step
+        if not complete:  # only the routes within ``width`` steps of the best
+            floor += (window - width) * s.step
         t = time.perf_counter()
         deadline = min(s.deadline, t + self.limit)
         y = cert.duals
@@ -461,6 +469,8 @@ class Enumeration:
         st.enum_left = len(lp)
         if none_listed:  # no plan worth need among the listed routes
             st.enum_status = "infeasible"
+            if not complete:
+                self._widen(width, res)
             return complete
         if time.perf_counter() >= deadline:
             return False
@@ -477,6 +487,8 @@ class Enumeration:
             self.incumbents.offer(plan)
             st.enum_improved += s.incumbent_value > before
         if not complete:
+            if status == "infeasible":  # no better plan among the listed routes
+                self._widen(width, res)
             return False
         if status == "infeasible":
             return True
@@ -484,6 +496,13 @@ class Enumeration:
             value = float(np.sum([m.prizes[np.asarray(r) - 1].sum() for r in plan]))
             return s.incumbent_value >= value - 1e-6
         return False
+
+    def _widen(self, width: float, res: "Enumerated") -> None:
+        """After a narrow try that listed no better plan: the next, ``WIDEN`` steps wider, if
+        its labels and routes (``GROWTH`` times as many) would stay within the caps."""
+        if (res.n_labels * self.GROWTH <= self.max_labels
+                and len(res.paths) * self.GROWTH <= self.max_routes):
+            self._wider = width + self.WIDEN
 
     def _tighten(self, lp: EnumeratedLP, need: float, y: np.ndarray, deadline: float) -> bool:
         """Rounds of full-memory triples on the LP over the listed routes, each followed by the
