@@ -11,7 +11,7 @@ import pytest
 
 from sarcover.formulations.bp import BPOptions, solve_bp
 from sarcover.formulations.bp.enumerated_lp import EnumeratedLP, _cut_coefficients
-from sarcover.formulations.bp.enumeration import enumerate_routes, packing_milp
+from sarcover.formulations.bp.enumeration import enumerate_routes
 from sarcover.formulations.bp.master import _lm_coefficient
 from sarcover.formulations.bp.node import NodeState, node_graph
 from sarcover.formulations.bp.tree import BranchAndPrice
@@ -84,12 +84,11 @@ def test_enumerated_lp_bounds_every_plan_and_its_filter_keeps_the_optimum(seed):
             break
         cuts += lp.add_cuts([(S, None) for S in new])
     assert all(b2 <= b1 + 1e-6 for b1, b2 in zip(bounds, bounds[1:]))  # cuts and filter only tighten
-    everything = frozenset(range(m.V + 2))
-    routes = [lp.route(i) for i in range(len(lp))]
-    status, plan = packing_milp(m, routes, opt, 30.0, cuts=[(frozenset(S), everything) for S, _ in lp.cuts])
-    assert status == "optimal"
-    assert sum(float(m.prizes[np.asarray(r) - 1].sum()) for r in plan) == pytest.approx(opt)
-    assert packing_milp(m, routes, opt + 1, 30.0)[0] == "infeasible"
+    for with_cuts in (False, True):
+        status, plan = lp.milp(opt, 30.0, cuts=with_cuts)
+        assert status == "optimal"
+        assert sum(float(m.prizes[np.asarray(r) - 1].sum()) for r in plan) == pytest.approx(opt)
+        assert lp.milp(opt + 1, 30.0, cuts=with_cuts)[0] == "infeasible"
 
 
 @pytest.mark.parametrize("seed", [0, 4])

@@ -13,7 +13,7 @@ After every round the routes are filtered by reduced cost: under optimal duals y
 all listed routes (value z, every route's reduced prize rc <= 0), a plan that uses route r is
 worth at most z + rc_r, so only routes with rc_r >= need - z can be part of a plan worth
 ``need``. An LP value below ``need`` proves there is none; otherwise the MILP over the routes
-left, with the cut rows, decides (:func:`.enumeration.packing_milp`).
+left decides (:meth:`EnumeratedLP.milp`).
 """
 
 from __future__ import annotations
@@ -230,3 +230,39 @@ class EnumeratedLP:
         self._set_routes(self.paths[mask])
         self.cut_matrix = coef.tocsr()
         self.in_lp = in_lp
+
+    def milp(self, need: float, time_limit: float, *, cuts: bool = False):
+        """The best plan of listed routes among those worth at least ``need`` (set packing over
+        the root rows and the row "prize >= need"; with ``cuts`` also the cut rows, valid for
+        every plan). Returns (status, routes): ("optimal", plan), ("infeasible", None): no such
+        plan, or ("open", plan or None) at the time limit. Without the cut rows by default: on
+        M = 20, K = 5 seed 100 HiGHS found the plan worth ``need`` among 6 413 routes in 15 s
+        without them, and not in 150 s with the 443 rows."""
+        m, k = self.master, len(self)
+        if k == 0:
+            return "infeasible", None
+        a = sp.hstack([self.base, sp.csr_matrix(self.prize[:, None])]
+                      + ([self.cut_matrix] if cuts else []), format="csr")
+        lo = np.concatenate([m.row_lo[: m.base_rows], [need], np.full(a.shape[1] - m.base_rows - 1, -INF)])
+        hi = np.concatenate([m.row_hi[: m.base_rows], [INF], np.ones(a.shape[1] - m.base_rows - 1)])
+        h = quiet_highs()
+        h.setOptionValue("time_limit", max(0.05, float(time_limit)))
+        h.setOptionValue("mip_rel_gap", 0.0)
+        h.setOptionValue("mip_abs_gap", 0.0)
+        h.changeObjectiveSense(highspy.ObjSense.kMaximize)
+        h.addRows(lo.size, lo, hi, 0, np.zeros(lo.size, np.int32), np.zeros(0, np.int32),
+                  np.zeros(0))
+        # the rows of ``a`` are the routes: its CSR arrays are the CSC arrays of the columns
+        h.addCols(k, self.prize, np.zeros(k), np.ones(k), a.nnz, a.indptr[:-1].astype(np.int32),
+                  a.indices.astype(np.int32), a.data)
+        h.changeColsIntegrality(k, np.arange(k, dtype=np.int32),
+                                np.full(k, highspy.HighsVarType.kInteger))
+        h.run()
+        st = h.getModelStatus()
+        if st == highspy.HighsModelStatus.kInfeasible:
+            return "infeasible", None
+        plan = None
+        if h.getInfo().primal_solution_status == 2:  # kSolutionStatusFeasible
+            x = np.asarray(h.getSolution().col_value)
+            plan = [self.route(r) for r in np.flatnonzero(x > 0.5)]
+        return ("optimal" if st == highspy.HighsModelStatus.kOptimal else "open"), plan

@@ -10,11 +10,12 @@ duals, no more energy), and pruned by the pricing's completion and suffix bounds
 fixed floor, on the graph the arc elimination leaves. Each visited set is one column of the
 master (its rows only see the set), so one route per set is enough.
 
-The MILP over them (vehicles <= N, each point at most once, each group covered; the subset-row
-cuts are valid inequalities and left out) with the row "prize >= incumbent + step" then decides
-the run: a solution is an optimal plan (every better plan is among its columns), infeasibility
-proves the incumbent optimal. Both only hold when the enumeration and the MILP finished; a cap
-or a time limit leaves the run as it was.
+The LP over them (:mod:`.enumerated_lp`: full-memory cuts, reduced-cost filter), then the MILP
+over the routes it leaves (vehicles <= N, each point at most once, each group covered) with the
+row "prize >= incumbent + step" decide the run: a solution is an optimal plan (every better plan
+is among its columns), an LP below that value or an infeasible MILP proves the incumbent
+optimal. Both only hold when the listing and the MILP finished; a cap or a time limit leaves the
+run as it was.
 """
 
 from __future__ import annotations
@@ -22,12 +23,10 @@ from __future__ import annotations
 import time
 from typing import TYPE_CHECKING, NamedTuple
 
-import highspy
 import numpy as np
 from numba import njit, objmode
 
 from sarcover.formulations.bp.enumerated_lp import EnumeratedLP
-from sarcover.formulations.bp.master import INF, _lm_coefficient, quiet_highs
 from sarcover.formulations.bp.node import NodeState, node_graph
 from sarcover.formulations.bp.pricing import (
     DP_UNITS, EPS, _byte_sums, _completion, _dp_bound, _dp_unit, _grow, _heap_pop, _heap_push,
@@ -300,62 +299,6 @@ def enumerate_routes(cost, profit, allowed, budget, threshold, *, ng=None, cut_m
     return Enumerated(paths, int(count))
 
 
-def packing_milp(master, routes, need: float, time_limit: float, *, cuts=(), need_row=True):
-    """The best plan over ``routes`` (set packing with the master's root rows: vehicles, each
-    point at most once, each group covered) among those worth at least ``need``. Returns
-    (status, routes): ("optimal", plan), ("infeasible", None): no such plan, or ("open", plan or
-    None) at the time limit. ``cuts``: (triple, memory) pairs of subset-row cuts, added as rows
-    (valid for every plan; they tighten the MILP's LP)."""
-    k = len(routes)
-    if k == 0:
-        return "infeasible", None
-    m = master
-    starts = np.zeros(k + 1, np.int64)
-    idx, val, prize = [], [], np.zeros(k)
-    rows_extra = m.base_rows  # the prize row after the root rows (no cut rows of the master)
-    for r, pts in enumerate(routes):
-        rows = {0: 1.0}
-        for p in pts:
-            rows[p] = 1.0
-            g = m.group_of_point[p]
-            if g >= 0:
-                row = 1 + m.V + g
-                rows[row] = rows.get(row, 0.0) + 1.0
-        pz = float(m.prizes[np.asarray(pts, dtype=np.int64) - 1].sum())
-        prize[r] = pz
-        rows[rows_extra] = pz
-        for c, (S, M) in enumerate(cuts):
-            a = _lm_coefficient(pts, S, M)
-            if a:
-                rows[rows_extra + 1 + c] = float(a)
-        for i in sorted(rows):
-            idx.append(i)
-            val.append(rows[i])
-        starts[r + 1] = len(idx)
-    h = quiet_highs()
-    h.setOptionValue("time_limit", max(0.05, float(time_limit)))
-    h.setOptionValue("mip_rel_gap", 0.0)
-    h.setOptionValue("mip_abs_gap", 0.0)
-    h.changeObjectiveSense(highspy.ObjSense.kMaximize)
-    lo = np.concatenate([m.row_lo[:rows_extra], [need if need_row else -INF], np.full(len(cuts), -INF)])
-    hi = np.concatenate([m.row_hi[:rows_extra], [INF], np.ones(len(cuts))])
-    h.addRows(lo.size, lo, hi, 0, np.zeros(lo.size, np.int32), np.zeros(0, np.int32),
-              np.zeros(0))
-    h.addCols(k, prize, np.zeros(k), np.ones(k), int(starts[-1]), starts[:-1].astype(np.int32),
-              np.asarray(idx, np.int32), np.asarray(val))
-    h.changeColsIntegrality(k, np.arange(k, dtype=np.int32),
-                            np.full(k, highspy.HighsVarType.kInteger))
-    h.run()
-    st = h.getModelStatus()
-    if st == highspy.HighsModelStatus.kInfeasible:
-        return "infeasible", None
-    plan = None
-    if h.getInfo().primal_solution_status == 2:  # kSolutionStatusFeasible
-        x = np.asarray(h.getSolution().col_value)
-        plan = [routes[r] for r in np.flatnonzero(x > 0.5)]
-    return ("optimal" if st == highspy.HighsModelStatus.kOptimal else "open"), plan
-
-
 def warm_up() -> None:
     """Compile (or load from numba's cache) the enumeration kernel on a tiny graph."""
     cost = np.array([[0.0, 1.0, 2.0], [1.0, 0.0, 1.0], [2.0, 1.0, 0.0]])
@@ -383,6 +326,10 @@ class Enumeration:
     triples per round."""
 
     WIDEN = 0.1  # steps added to a narrow window that listed no better plan
+    STALL = 0.002  # cut rounds stop when a round lowers the LP by less than this many steps
+    # the MILP is only tried over at most this many routes: over 60 827 (M = 20, K = 4 seed
+    # 111) HiGHS ran 150 s past a 100 s time limit, and every proof so far came from < 12 000
+    MILP_MAX = 20_000
     GROWTH = 10.0  # labels and routes per WIDEN more steps (measured on M = 20, K = 5, docs/bp.md)
 
     def __init__(self, search: "Search", elimination: "Elimination",
@@ -472,13 +419,10 @@ class Enumeration:
             if not complete:
                 self._widen(width, res)
             return complete
-        if time.perf_counter() >= deadline:
+        if time.perf_counter() >= deadline or len(lp) > self.MILP_MAX:
             return False
         t = time.perf_counter()
-        # without the cut rows: on M = 20, K = 5 seed 100 HiGHS found the plan worth ``need``
-        # among 6 413 routes in 15 s without them, and not in 150 s with the 443 rows
-        routes = [lp.route(i) for i in range(len(lp))]
-        status, plan = packing_milp(m, routes, need, deadline - t)
+        status, plan = lp.milp(need, deadline - t)
         st.enum_milp_s += time.perf_counter() - t
         st.enum_status = status
         if plan is not None:
@@ -508,17 +452,20 @@ class Enumeration:
         """Rounds of full-memory triples on the LP over the listed routes, each followed by the
         reduced-cost filter, until the LP shows that no plan of listed routes is worth ``need``
         (True), few enough routes are left for the MILP (``milp_routes``), no cut is violated,
-        or the deadline. ``y``: the root certificate's duals, whose best routes start the LP."""
+        a round lowers the LP by less than ``STALL`` steps, or the deadline. ``y``: the root certificate's duals, whose best routes start the LP."""
         s, st = self.search, self.search.stats
+        last = np.inf
         while True:
             out = lp.solve(y, deadline)
             if out is None:
                 return False
-            st.enum_lp_bound = out.bound(s.N)
-            if out.bound(s.N) < need - 1e-6:
+            st.enum_lp_bound = bound = out.bound(s.N)
+            if bound < need - 1e-6:
                 return True
             new = lp.separate(out.x, self.cuts_per_round)  # before the filter renumbers routes
             lp.keep(out.rc >= out.floor(need, s.N))
-            if len(lp) <= self.milp_routes or not new or time.perf_counter() >= deadline:
+            if (len(lp) <= self.milp_routes or not new or time.perf_counter() >= deadline
+                    or last - bound < self.STALL * s.step):
                 return False
+            last = bound
             st.enum_cuts += lp.add_cuts([(S, None) for S in new])
