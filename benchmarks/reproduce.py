@@ -19,7 +19,7 @@ table1            0.5 min   Table I timings: M=20, N=5, K=2..6, 30 instances eac
 top-chao          32 min    the exact methods (milp, cpsat, bp; 60 s) on TOP sets 1-3 against published optima
 paper-opt         2.1 h     the paper's grid (Fig. 3 and 4 settings, 20 instances each): every heuristic
                             (5 min) against bp's optimum (60 s at K<=3, 300 s at K=4,5, 600 s at K=6;
-                            K<=3 12 min, K=4 14 min, K=5 31 min, K=6 65 min on 2 workers)
+                            K<=3 12 min, K=4 17 min, K=5 30 min, K=6 65 min on 2 workers)
 decomposition     ~12 min   clustering / cross-cluster / routing loss of the paper methods, from
                             paper-opt's optima, at N=5 K=3, N=5 K=6 and K=3 N=2..6 (one instance per
                             worker; 755 of its 960 rows took 9.3 min on 2)

@@ -243,8 +243,9 @@ class EnumeratedLP:
             return "infeasible", None
         a = sp.hstack([self.base, sp.csr_matrix(self.prize[:, None])]
                       + ([self.cut_matrix] if cuts else []), format="csr")
-        lo = np.concatenate([m.row_lo[: m.base_rows], [need], np.full(a.shape[1] - m.base_rows - 1, -INF)])
-        hi = np.concatenate([m.row_hi[: m.base_rows], [INF], np.ones(a.shape[1] - m.base_rows - 1)])
+        n_cuts = a.shape[1] - m.base_rows - 1
+        lo = np.concatenate([m.row_lo[: m.base_rows], [need], np.full(n_cuts, -INF)])
+        hi = np.concatenate([m.row_hi[: m.base_rows], [INF], np.ones(n_cuts)])
         h = quiet_highs()
         h.setOptionValue("time_limit", max(0.05, float(time_limit)))
         h.setOptionValue("mip_rel_gap", 0.0)

@@ -326,11 +326,11 @@ class Enumeration:
     triples per round."""
 
     WIDEN = 0.1  # steps added to a narrow window that listed no better plan
+    GROWTH = 10.0  # labels and routes per WIDEN more steps (measured on M = 20, K = 5, docs/bp.md)
     STALL = 0.002  # cut rounds stop when a round lowers the LP by less than this many steps
     # the MILP is only tried over at most this many routes: over 60 827 (M = 20, K = 4 seed
     # 111) HiGHS ran 150 s past a 100 s time limit, and every proof so far came from < 12 000
     MILP_MAX = 20_000
-    GROWTH = 10.0  # labels and routes per WIDEN more steps (measured on M = 20, K = 5, docs/bp.md)
 
     def __init__(self, search: "Search", elimination: "Elimination",
                  incumbents: "IncumbentSearch", *, limit: float, gap: float, max_labels: int,
@@ -452,7 +452,8 @@ class Enumeration:
         """Rounds of full-memory triples on the LP over the listed routes, each followed by the
         reduced-cost filter, until the LP shows that no plan of listed routes is worth ``need``
         (True), few enough routes are left for the MILP (``milp_routes``), no cut is violated,
-        a round lowers the LP by less than ``STALL`` steps, or the deadline. ``y``: the root certificate's duals, whose best routes start the LP."""
+        a round lowers the LP by less than ``STALL`` steps, or the deadline. ``y``: the root
+        certificate's duals, whose best routes start the LP."""
         s, st = self.search, self.search.stats
         last = np.inf
         while True:
