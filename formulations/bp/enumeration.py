@@ -386,21 +386,20 @@ class Enumeration:
         cut = np.maximum(y[m.base_rows :], 0.0)[: len(m.cuts)]
         sig[: cut.size] = cut
         st = s.stats
+        st.enum_tries += 1
         try:
             res = enumerate_routes(cost, m.point_profit(y), allowed, s.budget, y[0] + floor,
                                    ng=s.ng, cut_members=m.cut_members, cut_memory=m.cut_memory,
                                    cut_duals=sig, max_labels=self.max_labels,
                                    max_routes=self.max_routes, deadline=deadline)
         except MemoryError:  # a process memory limit below what the label cap allows
-            st.enum_tries += 1
             st.enum_memory += 1
-            st.enum_s += time.perf_counter() - t
             return False
-        st.enum_tries += 1
+        finally:
+            st.enum_s += time.perf_counter() - t
         st.enum_complete += complete
         st.enum_labels = res.n_labels
         st.enum_routes = None if res.paths is None else len(res.paths)
-        st.enum_s += time.perf_counter() - t
         if res.paths is None:
             return False
         need = s.incumbent_value + (s.step if s.integral else 1e-9)
