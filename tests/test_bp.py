@@ -1350,6 +1350,27 @@ def test_enumeration_lists_every_route_above_the_threshold(seed, with_ng):
     assert all(value(r) > thr for r in res.routes)
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_enumeration_counts_what_a_narrower_listing_would_give(seed):
+    """With a margin, a listing counts the routes a listing at threshold + margin gives (exactly:
+    the sets whose best ordering clears it) and about its labels; its growth is their ratio."""
+    from sarcover.formulations.bp.enumeration import enumerate_routes
+    from sarcover.formulations.bp.pricing import nearest_ng
+
+    cost, _, profit, budget, (members, memory, sig), _, paths = _cut_priced(seed, 300 + seed)
+    n = cost.shape[0]
+    thr, margin = 0.3 * max(v for v, _ in paths), 0.2 * max(v for v, _ in paths)
+    kw = dict(ng=nearest_ng(cost, 3), cut_members=members, cut_memory=memory, cut_duals=sig)
+    wide = enumerate_routes(cost, profit, np.ones(n, dtype=bool), budget, thr, margin=margin, **kw)
+    narrow = enumerate_routes(cost, profit, np.ones(n, dtype=bool), budget, thr + margin, **kw)
+    assert 0 < narrow.inner_routes == len(narrow.routes) == wide.inner_routes < len(wide.routes)
+    assert narrow.inner_labels == narrow.n_labels - 1  # every label but the start
+    assert 0.5 * narrow.n_labels <= wide.inner_labels <= 2 * narrow.n_labels
+    labels, routes = wide.growth()
+    assert labels == pytest.approx(wide.n_labels / wide.inner_labels)
+    assert routes == pytest.approx(len(wide.routes) / len(narrow.routes)) and routes > 1
+
+
 def test_enumeration_keeps_the_published_optimum():
     """With enumeration on (any window), bp still proves the published TOP optima."""
     for name in ("p1.2.j", "p2.2.k", "p3.2.e", "p3.3.k"):

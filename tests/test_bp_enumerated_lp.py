@@ -127,22 +127,48 @@ def test_enumeration_out_of_memory_gives_up_the_try(monkeypatch, where):
 def test_narrow_tries_widen_until_complete(monkeypatch):
     """Above enum_gap a try lists only the routes within enum_primal_window steps of the best;
     when they hold no better plan the next try is WIDEN steps wider, and one as wide as the
-    window is complete and proves the optimum (WIDEN made large: the second try is complete)."""
+    window is complete and proves the optimum (WIDEN made large, its growth guard aside: the
+    second try is complete)."""
     from pathlib import Path
 
     from sarcover.formulations.bp.enumeration import Enumeration
     from sarcover.formulations.io import load_instance
 
     inst = load_instance(Path(__file__).resolve().parents[1] / "benchmarks/instances/top/p2.2.k.txt")
-    opts = BPOptions(enum_share=0.5, enum_gap=0.0, enum_primal_window=1e-3)
+    opts = BPOptions(enum_share=0.5, enum_gap=0.0, enum_primal_window=0.1)
     narrow = solve_bp(inst, time_limit=60, options=opts)
     assert narrow.info["enum_tries"] >= 2 and narrow.info["enum_complete"] == 0  # 0.1 wider each
+    # a wider listing that would pass the label cap, grown as over the narrow one's rim, is not
+    # tried (its labels grow here, a little)
+    capped = solve_bp(inst, time_limit=60, options=dataclasses.replace(
+        opts, enum_labels=narrow.info["enum_labels"] + 1))
+    assert capped.info["enum_tries"] == 1 and capped.status == Status.OPTIMAL
     monkeypatch.setattr(Enumeration, "WIDEN", 100.0)
+    monkeypatch.setattr(Enumeration, "_growth", lambda self, width, res: (1.0, 1.0))  # the guard aside
     res = solve_bp(inst, time_limit=60, options=opts)
     assert (res.info["enum_tries"], res.info["enum_complete"]) == (2, 1)
     assert res.status == Status.OPTIMAL and res.info["enum_status"] == "infeasible"
     assert verify(inst, res.plan).prize == pytest.approx(verify(inst, narrow.plan).prize)
-    # a wider listing that would pass the label cap (ten times the narrow one's labels) is not tried
-    capped = solve_bp(inst, time_limit=60, options=dataclasses.replace(
-        opts, enum_labels=5 * narrow.info["enum_labels"]))
-    assert capped.info["enum_tries"] == 1 and capped.status == Status.OPTIMAL
+
+
+def test_widening_is_guarded_by_the_growth_at_the_rim():
+    """A narrow try that listed no better plan is widened by WIDEN steps only if its labels and
+    routes, times their growth over the listing's rim (extrapolated geometrically to WIDEN
+    steps when the listing is narrower), fit the caps."""
+    from sarcover.formulations.bp.enumeration import Enumerated, Enumeration
+
+    res = Enumerated(np.zeros((100, 3), np.int32), n_labels=1000, inner_labels=250, inner_routes=50)
+    assert res.growth() == (4.0, 2.0)
+
+    def widened(width, max_labels, max_routes):
+        e = Enumeration(None, None, None, limit=1.0, gap=0.3, max_labels=max_labels,
+                        max_routes=max_routes, primal_window=0.2)
+        e._widen(width, res)
+        return e._wider
+
+    assert widened(0.2, 4000, 200) == pytest.approx(0.3)
+    assert widened(0.2, 3999, 200) is None and widened(0.2, 4000, 199) is None
+    # a rim of 0.05 steps: per 0.1 steps 16 times the labels and 4 times the routes
+    assert widened(0.05, 16_000, 400) == pytest.approx(0.15)
+    assert widened(0.05, 15_999, 400) is None and widened(0.05, 16_000, 399) is None
+    assert Enumerated(None, 7).growth() == (np.inf, np.inf)

@@ -52,7 +52,8 @@ def _key_hash(w, mask):
 
 @njit(cache=True)
 def _enumerate(cost, ret, profit, budget, allowed, order, cin, reach, lastord, cend, threshold,
-               max_labels, deadline, cmem, mmem, sig, g1, s1, g2, delta, nb, sfx, sdelta, snb):
+               max_labels, deadline, cmem, mmem, sig, g1, s1, g2, delta, nb, sfx, sdelta, snb,
+               margin):
     """Labels of every elementary path start -> ... whose prize (after the cuts' duals) plus
     the completion and suffix bounds exceeds ``threshold``; a label is dropped only when a label
     at the same point with the same visited set has no more energy and no less prize (after
@@ -62,7 +63,9 @@ def _enumerate(cost, ret, profit, budget, allowed, order, cin, reach, lastord, c
     above the threshold, a third bound.
 
     Labels with equal (point, set) form a list (``nxt``) whose head sits in an open-addressing
-    table. Returns (count, node, pred, energy, prize, mask, alive, hit_cap)."""
+    table. Returns (count, node, pred, energy, prize, mask, alive, hit_cap, inner), ``inner``
+    the labels made whose bounds also exceed ``threshold + margin`` (about the labels a listing
+    at that threshold would make)."""
     n = cost.shape[0]
     W = (n + 63) // 64
     cap = 1024
@@ -85,6 +88,7 @@ def _enumerate(cost, ret, profit, budget, allowed, order, cin, reach, lastord, c
     nxt[0] = -1
     count = 1
     hit = False
+    inner = 0
     hkey = np.empty(cap, np.float64)
     hval = np.empty(cap, np.int32)
     hkey[0] = 0.0
@@ -117,16 +121,20 @@ def _enumerate(cost, ret, profit, budget, allowed, order, cin, reach, lastord, c
             for k in range(W):
                 newmask[k] = mask[qi, k]
             newmask[wd] |= wb
-            if p2 + _dp_bound(g1, s1, g2, w, v, budget - e2, delta, nb) <= threshold:
+            ub = p2 + _dp_bound(g1, s1, g2, w, v, budget - e2, delta, nb)
+            if ub <= threshold:
                 continue
             if snb > 0:
                 # the path splits at the arc v -> w: pairs of a cut across the split only
                 # lower the route's prize further
                 b = min(int((budget - e2) / sdelta + 2e-9), snb)
-                if pr[qi] + sfx[w, b] <= threshold:
+                ub = min(ub, pr[qi] + sfx[w, b])
+                if ub <= threshold:
                     continue
-            if p2 + _completion(newmask, w, budget - e2, threshold - p2, order, profit, cin, reach,
-                                lastord, cend) <= threshold:
+            # the knapsack stops once above threshold + margin, so ub is exact up to there
+            ub = min(ub, p2 + _completion(newmask, w, budget - e2, threshold + margin - p2, order,
+                                          profit, cin, reach, lastord, cend))
+            if ub <= threshold:
                 continue
             # the labels of the same point and set: find the list's slot
             slot = np.int64(_key_hash(w, newmask) & np.uint64(tsize - 1))
@@ -175,6 +183,7 @@ def _enumerate(cost, ret, profit, budget, allowed, order, cin, reach, lastord, c
                 nxt = _grow(nxt, cap)
                 hkey = _grow(hkey, cap)
                 hval = _grow(hval, cap)
+            inner += ub > threshold + margin
             node[count] = w
             pred[count] = qi
             en[count] = e2
@@ -204,16 +213,28 @@ def _enumerate(cost, ret, profit, budget, allowed, order, cin, reach, lastord, c
         if hit:
             break
     return (count, node[:count], pred[:count], en[:count], pr[:count], mask[:count],
-            alive[:count], hit)
+            alive[:count], hit, inner)
 
 
 class Enumerated(NamedTuple):
     """Outcome of :func:`enumerate_routes`: the routes (one per visited set) as rows of solver
     points without start and end, padded with -1 (None when a cap or the deadline stopped the
-    search), and the labels made."""
+    search), and the labels made; of those, the labels whose bounds also clear the threshold
+    plus the ``margin`` and the routes whose best ordering does (``inner_routes``, exact: the
+    routes a listing at that threshold would give)."""
 
     paths: np.ndarray | None
     n_labels: int
+    inner_labels: int = 0
+    inner_routes: int = 0
+
+    def growth(self) -> tuple[float, float]:
+        """Labels and routes of this listing over those ``margin`` further in: how many times
+        more a listing ``margin`` wider would make, if they grow geometrically (inf when nothing
+        lies that far in)."""
+        routes = 0 if self.paths is None else len(self.paths)
+        return (self.n_labels / self.inner_labels if self.inner_labels else np.inf,
+                routes / self.inner_routes if self.inner_routes else np.inf)
 
     @property
     def routes(self) -> list | None:
@@ -225,12 +246,13 @@ class Enumerated(NamedTuple):
 
 def enumerate_routes(cost, profit, allowed, budget, threshold, *, ng=None, cut_members=None,
                      cut_memory=None, cut_duals=None, max_labels=5_000_000,
-                     max_routes=300_000, deadline=np.inf) -> Enumerated:
+                     max_routes=300_000, deadline=np.inf, margin=0.0) -> Enumerated:
     """Every elementary route start -> ... -> end of energy <= ``budget`` whose prize (sum of
     ``profit`` over its points, the cuts' duals paid as in the pricing) exceeds ``threshold``,
     one per set of points. ``cost`` has removed arcs at inf; ``allowed``: the points a route may
     visit. None (in ``routes``) when more than ``max_labels`` labels or ``max_routes`` routes
-    would be needed, or at the ``deadline``.
+    would be needed, or at the ``deadline``. ``margin``: also count the labels and routes that
+    clear ``threshold + margin`` (:meth:`Enumerated.growth`).
 
     With ``ng`` (ng sets) a backward exact ng-labelling over the whole budget first tabulates
     the best suffix from each point by energy (:func:`.pricing._label_table`, the cuts' duals
@@ -267,20 +289,23 @@ def enumerate_routes(cost, profit, allowed, budget, threshold, *, ng=None, cut_m
             sfx, sdelta, snb = np.ascontiguousarray(bwd[0][perm]), delta, nb
     ret = cheapest_return(cost)
     order, cin, reach, lastord, cend = _prepare(cost, ret, profit, allowed)
-    count, node, pred, en, pr, mask, _, hit = _enumerate(
+    count, node, pred, en, pr, mask, _, hit, inner = _enumerate(
         cost, ret, profit, float(budget), allowed, order, cin, reach, lastord, cend,
         float(threshold), int(max_labels), float(deadline), cmem, mmem, sig,
-        *suffix_tables(cost, profit, allowed, budget), sfx, float(sdelta), int(snb))
+        *suffix_tables(cost, profit, allowed, budget), sfx, float(sdelta), int(snb), float(margin))
     if hit:
         return Enumerated(None, int(count))
     end = n - 1
     done = np.flatnonzero((node > 0) & (en + cost[node, end] <= budget) & (pr > threshold))
     # one label per visited set (the cheapest; any would do for the master's column)
     done = done[np.argsort(en[done], kind="stable")]
-    _, first = np.unique(mask[done], axis=0, return_index=True)
+    _, first, which = np.unique(mask[done], axis=0, return_index=True, return_inverse=True)
+    best = np.full(first.size, -np.inf)
+    np.maximum.at(best, which.ravel(), pr[done])  # the set's best ordering
     done = done[np.sort(first)]
     if done.size > max_routes:
         return Enumerated(None, int(count))
+    counts = (int(count), int(inner), int(np.sum(best > threshold + margin)))
     # the paths, all at once: walk the predecessors back level by level (last point first)
     levels = []  # (routes still walking, their point at this level)
     cur = done.copy()
@@ -296,7 +321,7 @@ def enumerate_routes(cost, profit, allowed, budget, threshold, *, ng=None, cut_m
     paths = np.full((done.size, len(levels)), -1, np.int32)
     for k, (live, pts) in enumerate(levels):  # the k-th point from the end of each route
         paths[live, length[live] - 1 - k] = pts
-    return Enumerated(paths, int(count))
+    return Enumerated(paths, *counts)
 
 
 def warm_up() -> None:
@@ -319,14 +344,14 @@ class Enumeration:
     plan. The plan one step above the incumbent has a total slack of the window over its
     routes, so most of its routes sit well inside a narrow window. A narrow try that finds no
     plan is followed by one ``WIDEN`` steps wider (with the same certificate and incumbent) if
-    its labels and routes, ``GROWTH`` times as many, stay within the caps; a try as wide as the
-    window is complete. ``primal_window`` 0 turns the narrow tries off. ``limit``: seconds per
+    its labels and routes, times their growth over the last ``WIDEN`` steps of the narrow
+    listing (:meth:`Enumerated.growth`), stay within the caps; a try as wide as the window is
+    complete. ``primal_window`` 0 turns the narrow tries off. ``limit``: seconds per
     try; ``max_labels``, ``max_routes``: the caps beyond which a listing gives up;
     ``milp_routes``: cut rounds stop once this few routes are left; ``cuts_per_round``:
     triples per round."""
 
     WIDEN = 0.1  # steps added to a narrow window that listed no better plan
-    GROWTH = 10.0  # labels and routes per WIDEN more steps (measured on M = 20, K = 5, docs/bp.md)
     STALL = 0.002  # cut rounds stop when a round lowers the LP by less than this many steps
     # the MILP is only tried over at most this many routes: over 60 827 (M = 20, K = 4 seed
     # 111) HiGHS ran 150 s past a 100 s time limit, and every proof so far came from < 12 000
@@ -391,7 +416,8 @@ class Enumeration:
             res = enumerate_routes(cost, m.point_profit(y), allowed, s.budget, y[0] + floor,
                                    ng=s.ng, cut_members=m.cut_members, cut_memory=m.cut_memory,
                                    cut_duals=sig, max_labels=self.max_labels,
-                                   max_routes=self.max_routes, deadline=deadline)
+                                   max_routes=self.max_routes, deadline=deadline,
+                                   margin=self._counted(width) * s.step)
         except MemoryError:  # a process memory limit below what the label cap allows
             st.enum_memory += 1
             return False
@@ -400,6 +426,8 @@ class Enumeration:
         st.enum_complete += complete
         st.enum_labels = res.n_labels
         st.enum_routes = None if res.paths is None else len(res.paths)
+        growth = self._growth(width, res)[0] if res.paths is not None else np.inf
+        st.enum_growth = round(growth, 3) if np.isfinite(growth) else None
         if res.paths is None:
             return False
         need = s.incumbent_value + (s.step if s.integral else 1e-9)
@@ -442,10 +470,22 @@ class Enumeration:
 
     def _widen(self, width: float, res: "Enumerated") -> None:
         """After a narrow try that listed no better plan: the next, ``WIDEN`` steps wider, if
-        its labels and routes (``GROWTH`` times as many) would stay within the caps."""
-        if (res.n_labels * self.GROWTH <= self.max_labels
-                and len(res.paths) * self.GROWTH <= self.max_routes):
+        its labels and routes would stay within the caps, were they to grow as much as over the
+        narrow listing's last ``WIDEN`` steps."""
+        labels, routes = self._growth(width, res)
+        if (res.n_labels * labels <= self.max_labels
+                and len(res.paths) * routes <= self.max_routes):
             self._wider = width + self.WIDEN
+
+    def _counted(self, width: float) -> float:
+        """The steps at the rim of a ``width``-wide listing over which it counts its growth."""
+        return min(self.WIDEN, width) if width > 0 else self.WIDEN
+
+    def _growth(self, width: float, res: "Enumerated") -> tuple[float, float]:
+        """Labels and routes: how many times more a listing ``WIDEN`` steps wider than ``res``
+        (``width`` steps wide) would make, growing geometrically as over its rim."""
+        power = self.WIDEN / self._counted(width)
+        return tuple(g ** power if g > 1 else 1.0 for g in res.growth())
 
     def _tighten(self, lp: EnumeratedLP, need: float, y: np.ndarray, deadline: float) -> bool:
         """Rounds of full-memory triples on the LP over the listed routes, each followed by the

@@ -43,6 +43,7 @@ class Stats:
     enum_memory: int = 0  # tries stopped by a MemoryError (a process memory limit)
     enum_labels: int | None = None  # labels and routes of the last one (routes None: capped)
     enum_routes: int | None = None
+    enum_growth: float | None = None  # its labels over those WIDEN steps further in (None: inf)
     enum_s: float = 0.0
     enum_lp_s: float = 0.0  # the LP over the enumerated routes, its cut rounds and filter
     enum_lp_bound: float | None = None  # its last bound
@@ -78,7 +79,8 @@ class Stats:
             "enum_tries": self.enum_tries, "enum_complete": self.enum_complete,
             "enum_improved": self.enum_improved, "enum_memory": self.enum_memory,
             "enum_labels": self.enum_labels,
-            "enum_routes": self.enum_routes, "enum_s": round(self.enum_s, 3),
+            "enum_routes": self.enum_routes, "enum_growth": self.enum_growth,
+            "enum_s": round(self.enum_s, 3),
             "enum_lp_s": round(self.enum_lp_s, 3), "enum_lp_bound": self.enum_lp_bound,
             "enum_cuts": self.enum_cuts, "enum_left": self.enum_left,
             "enum_milp_s": round(self.enum_milp_s, 3), "enum_status": self.enum_status,
