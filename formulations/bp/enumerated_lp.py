@@ -26,7 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from sarcover.formulations.bp.master import INF, quiet_highs, spread, violated_triples
+from sarcover.formulations.bp.master import INF, packing_milp, quiet_highs, spread, violated_triples
 
 
 @njit(cache=True)
@@ -246,19 +246,9 @@ class EnumeratedLP:
         n_cuts = a.shape[1] - m.base_rows - 1
         lo = np.concatenate([m.row_lo[: m.base_rows], [need], np.full(n_cuts, -INF)])
         hi = np.concatenate([m.row_hi[: m.base_rows], [INF], np.ones(n_cuts)])
-        h = quiet_highs()
-        h.setOptionValue("time_limit", max(0.05, float(time_limit)))
-        h.setOptionValue("mip_rel_gap", 0.0)
-        h.setOptionValue("mip_abs_gap", 0.0)
-        h.changeObjectiveSense(highspy.ObjSense.kMaximize)
-        h.addRows(lo.size, lo, hi, 0, np.zeros(lo.size, np.int32), np.zeros(0, np.int32),
-                  np.zeros(0))
         # the rows of ``a`` are the routes: its CSR arrays are the CSC arrays of the columns
-        h.addCols(k, self.prize, np.zeros(k), np.ones(k), a.nnz, a.indptr[:-1].astype(np.int32),
-                  a.indices.astype(np.int32), a.data)
-        h.changeColsIntegrality(k, np.arange(k, dtype=np.int32),
-                                np.full(k, highspy.HighsVarType.kInteger))
-        h.run()
+        h = packing_milp(lo, hi, self.prize, np.ones(k), a.indptr[:-1].astype(np.int32),
+                         a.indices.astype(np.int32), a.data, time_limit, abs_gap=True)
         st = h.getModelStatus()
         if st == highspy.HighsModelStatus.kInfeasible:
             return "infeasible", None

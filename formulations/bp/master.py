@@ -62,6 +62,32 @@ def quiet_highs() -> highspy.Highs:
     return h
 
 
+def packing_milp(lo, hi, prize, ub, starts, index, value, time_limit: float, *,
+                 first: np.ndarray | None = None, abs_gap: bool = False) -> highspy.Highs:
+    """HiGHS run on a set-packing MILP over routes: binary columns (``prize``, upper bounds
+    ``ub``, CSC arrays ``starts``, ``index``, ``value`` with ``starts`` holding the columns'
+    first entries), rows between ``lo`` and ``hi``, maximised to a zero relative gap (and zero
+    absolute gap with ``abs_gap``) within ``time_limit`` seconds; ``first``: a 0/1 first
+    solution. The caller reads the outcome from the returned solver."""
+    k = len(prize)
+    h = quiet_highs()
+    h.setOptionValue("time_limit", max(0.05, float(time_limit)))
+    h.setOptionValue("mip_rel_gap", 0.0)
+    if abs_gap:
+        h.setOptionValue("mip_abs_gap", 0.0)
+    h.changeObjectiveSense(highspy.ObjSense.kMaximize)
+    h.addRows(len(lo), lo, hi, 0, np.zeros(len(lo), np.int32), np.zeros(0, np.int32), np.zeros(0))
+    h.addCols(k, prize, np.zeros(k), ub, len(index), starts, index, value)
+    h.changeColsIntegrality(k, np.arange(k, dtype=np.int32), np.full(k, highspy.HighsVarType.kInteger))
+    if first is not None:
+        sol = highspy.HighsSolution()
+        sol.col_value = np.asarray(first, dtype=float).tolist()
+        sol.value_valid = True
+        h.setSolution(sol)
+    h.run()
+    return h
+
+
 def _lm_coefficient(route, S, memory) -> int:
     """Pairs of visits to S along the route, an unpaired visit forgotten outside ``memory``."""
     odd, pairs = False, 0
@@ -486,29 +512,16 @@ class Master:
             first = [pos.get(tuple(r)) for r in start]
             if None in first or any(i in self.repeated for i in first):
                 first = None  # not a selection of the generated elementary routes
-        h = quiet_highs()
-        h.setOptionValue("time_limit", max(0.05, float(time_limit)))
-        h.setOptionValue("mip_rel_gap", 0.0)
-        h.changeObjectiveSense(highspy.ObjSense.kMaximize)
-        h.addRows(self.n_rows, self.row_lo, self.row_hi, 0, np.zeros(self.n_rows, np.int32),
-                  np.zeros(0, np.int32), np.zeros(0))
         starts, index, value = self._route_matrix()
         ub = np.ones(k) if allowed is None else np.where(allowed, 1.0, 0.0)
         ub[self.repeated] = 0.0  # never in an integer solution
+        x0 = None
         if first is not None:
             ub[first] = 1.0  # the start's routes, even where ``allowed`` leaves them out
-        h.addCols(k, np.asarray(self.route_prize), np.zeros(k), ub, int(starts[-1]),
-                  starts[:-1].astype(np.int32), index, value)
-        h.changeColsIntegrality(k, np.arange(k, dtype=np.int32),
-                                np.full(k, highspy.HighsVarType.kInteger))
-        if first is not None:
-            sol = highspy.HighsSolution()
             x0 = np.zeros(k)
             x0[first] = 1.0
-            sol.col_value = x0.tolist()
-            sol.value_valid = True
-            h.setSolution(sol)
-        h.run()
+        h = packing_milp(self.row_lo, self.row_hi, np.asarray(self.route_prize), ub,
+                         starts[:-1].astype(np.int32), index, value, time_limit, first=x0)
         if h.getInfo().primal_solution_status != 2:  # kSolutionStatusFeasible
             return None
         x = np.asarray(h.getSolution().col_value)
