@@ -344,9 +344,9 @@ class Enumeration:
     plan. The plan one step above the incumbent has a total slack of the window over its
     routes, so most of its routes sit well inside a narrow window. A narrow try that finds no
     plan is followed by one ``WIDEN`` steps wider (with the same certificate and incumbent) if
-    its labels and routes, times their growth over the last ``WIDEN`` steps of the narrow
-    listing (:meth:`Enumerated.growth`), stay within the caps; a try as wide as the window is
-    complete. ``primal_window`` 0 turns the narrow tries off. ``limit``: seconds per
+    its labels and routes, times their growth at the narrow listing's rim (over its last
+    ``WIDEN`` steps, or all of it if narrower, extrapolated geometrically to ``WIDEN`` steps:
+    :meth:`Enumerated.growth`), stay within the caps; a try as wide as the window is complete. ``primal_window`` 0 turns the narrow tries off. ``limit``: seconds per
     try; ``max_labels``, ``max_routes``: the caps beyond which a listing gives up;
     ``milp_routes``: cut rounds stop once this few routes are left; ``cuts_per_round``:
     triples per round."""
@@ -470,8 +470,8 @@ class Enumeration:
 
     def _widen(self, width: float, res: "Enumerated") -> None:
         """After a narrow try that listed no better plan: the next, ``WIDEN`` steps wider, if
-        its labels and routes would stay within the caps, were they to grow as much as over the
-        narrow listing's last ``WIDEN`` steps."""
+        its labels and routes would stay within the caps, were they to grow as at the narrow
+        listing's rim (:meth:`_growth`)."""
         labels, routes = self._growth(width, res)
         if (res.n_labels * labels <= self.max_labels
                 and len(res.paths) * routes <= self.max_routes):
