@@ -13,13 +13,13 @@ paper-k           5 min     Fig. 4 / Table I: M=20, N=5, K=2..6; same methods
 paper-peers       3.5 min   routing (2 s) and pyvrp (1 s) on the first 20 instances of every setting above
 exact-small       10 min    every method on 8-40 viewpoints; milp, cpsat, bp (60 s) prove optima -> gaps
 paper-gaps        6 min     M=20, N=5, K=3 and 6 (8 instances each): heuristics against bp's bound (60 s)
-paper-gaps-long   11 min    bp at 300 s (subset-row cuts on) on K=3 seed 5 and K=6 seeds 0..3 of paper-gaps
+paper-gaps-long   8 min     bp at 300 s (subset-row cuts on) on K=3 seed 5 and K=6 seeds 0..3 of paper-gaps
 emax-sweep        1.5 min   coverage against E_max = 4000..9000 at M=20, N=5, K=3 (50 instances per budget)
 table1            0.5 min   Table I timings: M=20, N=5, K=2..6, 30 instances each, on ONE worker
 top-chao          32 min    the exact methods (milp, cpsat, bp; 60 s) on TOP sets 1-3 against published optima
-paper-opt         2.1 h     the paper's grid (Fig. 3 and 4 settings, 20 instances each): every heuristic
-                            (5 min) against bp's optimum (60 s at K<=3, 300 s at K=4,5, 600 s at K=6;
-                            K<=3 12 min, K=4 17 min, K=5 30 min, K=6 65 min on 2 workers)
+paper-opt         1.8 h     the paper's grid (Fig. 3 and 4 settings, 20 instances each): every heuristic
+                            against bp's optimum (60 s at K<=3, 300 s at K=4,5, 600 s at K=6; the
+                            heuristics and K<=3 11 min, K=4 16 min, K=5 24 min, K=6 56 min on 2 workers)
 decomposition     ~12 min   clustering / cross-cluster / routing loss of the paper methods, from
                             paper-opt's optima, at N=5 K=3, N=5 K=6 and K=3 N=2..6 (one instance per
                             worker; 755 of its 960 rows took 9.3 min on 2)
