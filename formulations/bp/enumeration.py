@@ -346,8 +346,9 @@ class Enumeration:
     plan is followed by one ``WIDEN`` steps wider (with the same certificate and incumbent) if
     its labels and routes, times their growth at the narrow listing's rim (over its last
     ``WIDEN`` steps, or all of it if narrower, extrapolated geometrically to ``WIDEN`` steps:
-    :meth:`Enumerated.growth`), stay within the caps; a try as wide as the window is complete. ``primal_window`` 0 turns the narrow tries off. ``limit``: seconds per
-    try; ``max_labels``, ``max_routes``: the caps beyond which a listing gives up;
+    :meth:`Enumerated.growth`), stay within the caps; a try as wide as the window is complete.
+    ``primal_window`` 0 turns the narrow tries off. ``limit``: seconds per try;
+    ``max_labels``, ``max_routes``: the caps beyond which a listing gives up;
     ``milp_routes``: cut rounds stop once this few routes are left; ``cuts_per_round``:
     triples per round."""
 
