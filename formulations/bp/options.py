@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 CUTS_FROM_S = 60.0  # time limits from which subset-row cuts are on by default
 OPEN_CUTS_FROM_S = 300.0  # ... and from which they are tried however far the LP is from a drop
 MORE_PRIMAL_FROM_S = 600.0  # time limits from which the root calls the primal heuristic 4 times
-ENUM_FROM_S = 300.0  # time limits from which route enumeration is on by default
+ENUM_FROM_S = 60.0  # time limits from which route enumeration is on by default
 
 
 def default_cut_rounds(time_limit: float | None) -> int:
@@ -33,8 +33,9 @@ def default_primal_calls(time_limit: float | None) -> int:
 
 def default_enum_share(time_limit: float | None) -> float:
     """Share of the limit for one route enumeration try by default: 0.6 from ``ENUM_FROM_S``
-    (and without a limit, where a try gets 30 s), else 0 (off): the root alone takes about a
-    third of 300 s on M = 20, K = 5, and a complete listing up to another third (docs/bp.md)."""
+    (and without a limit, where a try gets 30 s), else 0 (off). The root alone takes about a
+    third of 300 s on M = 20, K = 5 and of 60 s on M = 20, K = 3, and a complete listing up to
+    another third; at 60 s it closes the K = 3 roots that branching leaves open (docs/bp.md)."""
     return 0.6 if time_limit is None or float(time_limit) >= ENUM_FROM_S else 0.0
 
 
@@ -115,7 +116,7 @@ class BPOptions:
 
     - ``enum_share``: seconds for one try (listing the routes, the LP over them with its cuts,
       the MILP over the routes left), as a share of the limit (30 s without one); 0 turns
-      enumeration off. None: 0.6 from ``ENUM_FROM_S`` (300 s), else 0.
+      enumeration off. None: 0.6 from ``ENUM_FROM_S`` (60 s), else 0.
     - ``enum_gap``: the listing is complete (its outcome a proof) while the root certificate's
       bound is at most this many prize steps above the incumbent + one step; the number of
       routes to list grows four- to sixfold per 0.1 step on M = 20, K = 5 (docs/bp.md).
