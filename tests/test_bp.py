@@ -13,7 +13,8 @@ import pytest
 
 from sarcover.benchmarks.registry import run_method
 from sarcover.formulations.bp import BPOptions, solve_bp
-from sarcover.formulations.bp.options import CUTS_FROM_S, ENUM_FROM_S, MORE_PRIMAL_FROM_S, OPEN_CUTS_FROM_S
+from sarcover.formulations.bp.options import (CUTS_FROM_S, ENUM_FROM_S, ENUM_LABELS, ENUM_LABELS_FROM_S,
+                                              MORE_PRIMAL_FROM_S, OPEN_CUTS_FROM_S)
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.io import load_instance
 from sarcover.formulations.plan import Plan
@@ -1135,7 +1136,8 @@ def test_cuts_match_brute_force(seed):
 
 
 @pytest.mark.parametrize("offset", [0.0, -1.0])
-@pytest.mark.parametrize("threshold", ["CUTS_FROM_S", "OPEN_CUTS_FROM_S", "MORE_PRIMAL_FROM_S", "ENUM_FROM_S"])
+@pytest.mark.parametrize("threshold", ["CUTS_FROM_S", "OPEN_CUTS_FROM_S", "MORE_PRIMAL_FROM_S", "ENUM_FROM_S",
+                                       "ENUM_LABELS_FROM_S"])
 def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, threshold):
     """The registered bp spends a moment on greedy before solve_bp; whether cuts are on, how
     open their gate is, how often the primal heuristic runs and whether route enumeration is on
@@ -1146,7 +1148,7 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, thre
     import sarcover.formulations.bp.options as bp_options
     from sarcover.benchmarks.registry import METHODS
     from sarcover.formulations.bp.options import (CUTS_FROM_S, OPEN_CUTS_FROM_S, default_cut_gap,
-                                                  default_cut_rounds)
+                                                  default_cut_rounds, default_enum_labels)
     from sarcover.formulations.result import Result, Termination
 
     limit = getattr(bp_options, threshold) + offset
@@ -1163,11 +1165,12 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, thre
     assert seen["options"].cut_gap == default_cut_gap(limit) == (1.0 if limit >= OPEN_CUTS_FROM_S else 0.5)
     assert seen["options"].primal_calls == (4 if limit >= MORE_PRIMAL_FROM_S else 2)
     assert seen["options"].enum_share == (0.6 if limit >= ENUM_FROM_S else 0.0)
+    assert seen["options"].enum_labels == default_enum_labels(limit)
 
 
 def test_enumeration_is_on_by_default_for_long_runs_only():
     """Route enumeration after the root: by default from ENUM_FROM_S seconds (and without a
-    limit); an explicit enum_share wins either way."""
+    limit); an explicit enum_share wins either way. So does an explicit label cap."""
     from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = random_tiny(0, groups=False)
@@ -1176,6 +1179,13 @@ def test_enumeration_is_on_by_default_for_long_runs_only():
     assert BranchAndPrice(inst, time_limit=None).enumeration is not None
     assert BranchAndPrice(inst, time_limit=None, options=BPOptions(enum_share=0)).enumeration is None
     assert BranchAndPrice(inst, time_limit=10, options=BPOptions(enum_share=0.5)).enumeration is not None
+    # a try's label cap: in proportion to the limit below ENUM_LABELS_FROM_S, an explicit one wins
+    assert BranchAndPrice(inst, time_limit=ENUM_FROM_S).enumeration.max_labels == int(
+        ENUM_LABELS * ENUM_FROM_S / ENUM_LABELS_FROM_S) < ENUM_LABELS
+    assert BranchAndPrice(inst, time_limit=ENUM_LABELS_FROM_S).enumeration.max_labels == ENUM_LABELS
+    assert BranchAndPrice(inst, time_limit=None).enumeration.max_labels == ENUM_LABELS
+    assert BranchAndPrice(inst, time_limit=ENUM_FROM_S,
+                          options=BPOptions(enum_labels=1000)).enumeration.max_labels == 1000
 
 
 def test_cuts_are_on_by_default_for_long_runs_only():
@@ -1207,7 +1217,8 @@ def test_cut_gate_opens_for_long_runs():
                                    OPEN_CUTS_FROM_S, MORE_PRIMAL_FROM_S - 1, MORE_PRIMAL_FROM_S, None])
 def test_options_for_time_limit(limit):
     """BPOptions.for_time_limit: the defaults, with the cut settings decided on the limit (cuts
-    on from CUTS_FROM_S, their gate open from OPEN_CUTS_FROM_S); options that leave them None
+    on from CUTS_FROM_S, their gate open from OPEN_CUTS_FROM_S), and so are the primal calls,
+    route enumeration and its label cap; options that leave them None
     get the same from the solve's own limit; the options are frozen."""
     import dataclasses
 
@@ -1216,8 +1227,10 @@ def test_options_for_time_limit(limit):
     assert opts.cut_rounds == (6 if on else 0) and opts.cut_gap == (1.0 if open_gate else 0.5)
     assert opts.primal_calls == (4 if limit is None or limit >= MORE_PRIMAL_FROM_S else 2)
     assert opts.enum_share == (0.6 if limit is None or limit >= ENUM_FROM_S else 0.0)
+    assert opts.enum_labels == (ENUM_LABELS if limit is None or limit >= ENUM_LABELS_FROM_S
+                                else int(ENUM_LABELS * limit / ENUM_LABELS_FROM_S))
     assert dataclasses.replace(opts, cut_rounds=None, cut_gap=None, primal_calls=None,
-                               enum_share=None) == BPOptions()
+                               enum_share=None, enum_labels=None) == BPOptions()
     assert BPOptions().with_limit_defaults(limit) == opts
     assert BPOptions(cut_rounds=2, strong=1).with_limit_defaults(limit).cut_rounds == 2
     with pytest.raises(dataclasses.FrozenInstanceError):

@@ -16,6 +16,8 @@ CUTS_FROM_S = 60.0  # time limits from which subset-row cuts are on by default
 OPEN_CUTS_FROM_S = 300.0  # ... and from which they are tried however far the LP is from a drop
 MORE_PRIMAL_FROM_S = 600.0  # time limits from which the root calls the primal heuristic 4 times
 ENUM_FROM_S = 60.0  # time limits from which route enumeration is on by default
+ENUM_LABELS = 1 << 24  # labels one enumeration try may make, by default from ENUM_LABELS_FROM_S
+ENUM_LABELS_FROM_S = 300.0  # ... below which the labels are cut in proportion to the limit
 
 
 def default_cut_rounds(time_limit: float | None) -> int:
@@ -37,6 +39,17 @@ def default_enum_share(time_limit: float | None) -> float:
     third of 300 s on M = 20, K = 5 and of 60 s on M = 20, K = 3, and a complete listing up to
     another third; at 60 s it closes the K = 3 roots that branching leaves open (docs/bp.md)."""
     return 0.6 if time_limit is None or float(time_limit) >= ENUM_FROM_S else 0.0
+
+
+def default_enum_labels(time_limit: float | None) -> int:
+    """Labels one route enumeration try may make before it gives up, by default: ``ENUM_LABELS``
+    (about 1.2 GB) from ``ENUM_LABELS_FROM_S`` (and without a limit), below it in proportion to
+    the limit (3.4 M at 60 s). A listing makes 0.3-0.8 M labels a second, so a try that cannot
+    finish gives up before it takes the time the tree needs; at 60 s the listings that proved
+    M = 20, K = 3 instances made at most 2 M (docs/bp.md)."""
+    if time_limit is None or float(time_limit) >= ENUM_LABELS_FROM_S:
+        return ENUM_LABELS
+    return int(ENUM_LABELS * float(time_limit) / ENUM_LABELS_FROM_S)
 
 
 def default_cut_gap(time_limit: float | None) -> float:
@@ -128,6 +141,7 @@ class BPOptions:
     - ``enum_labels``, ``enum_routes``: a try gives up beyond this many labels or routes. The
       labels take about 70 bytes each, so 2^24 (16.8 M) stay near 1.2 GB, within the
       harness's 4 GB per worker; a try that still runs out of memory gives up as well.
+      ``enum_labels`` None: by the time limit (:func:`default_enum_labels`).
     """
 
     ng_size: int = 8
@@ -155,7 +169,7 @@ class BPOptions:
     enum_share: float | None = None
     enum_gap: float = 0.3
     enum_primal_window: float = 0.2
-    enum_labels: int = 1 << 24
+    enum_labels: int | None = None
     enum_routes: int = 3_000_000
 
     @classmethod
@@ -167,7 +181,7 @@ class BPOptions:
 
     def with_limit_defaults(self, time_limit: float | None) -> "BPOptions":
         """These options with the settings left None (``cut_rounds``, ``cut_gap``,
-        ``primal_calls``, ``enum_share``) decided on ``time_limit``."""
+        ``primal_calls``, ``enum_share``, ``enum_labels``) decided on ``time_limit``."""
         return replace(
             self,
             cut_rounds=(default_cut_rounds(time_limit) if self.cut_rounds is None
@@ -176,5 +190,7 @@ class BPOptions:
             primal_calls=(default_primal_calls(time_limit) if self.primal_calls is None
                           else self.primal_calls),
             enum_share=(default_enum_share(time_limit) if self.enum_share is None
-                        else self.enum_share))
+                        else self.enum_share),
+            enum_labels=(default_enum_labels(time_limit) if self.enum_labels is None
+                         else self.enum_labels))
 
