@@ -1140,10 +1140,10 @@ def test_cuts_match_brute_force(seed):
                                        "ENUM_LABELS_FROM_S"])
 def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, threshold):
     """The registered bp spends a moment on greedy before solve_bp; whether cuts are on, how
-    open their gate is, how often the primal heuristic runs and whether route enumeration is on
-    follow the user's time limit (at CUTS_FROM_S: on; at OPEN_CUTS_FROM_S: open; at
-    MORE_PRIMAL_FROM_S: 4 calls; at ENUM_FROM_S: on), not the slightly smaller one left for
-    solve_bp."""
+    open their gate is, how often the primal heuristic runs, whether route enumeration is on and
+    how many labels its tries may make follow the user's time limit (at CUTS_FROM_S: on; at
+    OPEN_CUTS_FROM_S: open; at MORE_PRIMAL_FROM_S: 4 calls; at ENUM_FROM_S: on; at
+    ENUM_LABELS_FROM_S: the full cap), not the slightly smaller one left for solve_bp."""
     import sarcover.formulations.bp as bp_package
     import sarcover.formulations.bp.options as bp_options
     from sarcover.benchmarks.registry import METHODS
