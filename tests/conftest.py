@@ -1,5 +1,6 @@
 """Shared fixtures: tiny instances that can be checked by hand."""
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -8,6 +9,8 @@ import pytest
 from sarcover.formulations.instance import TOPInstance
 
 ROOT = Path(__file__).resolve().parents[1]
+# the shared helpers (this file, tests/helpers.py) import by name from any test folder
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 TOP_DIR = ROOT / "benchmarks" / "instances" / "top"
 
 
