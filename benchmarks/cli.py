@@ -3,7 +3,7 @@
 Exit codes (README, "Exit codes"): 0 success (for ``solve``: a verified plan came back); 2 bad
 input, with one line on stderr naming the problem; ``solve`` only: 3 no plan (``infeasible``, or
 ``no_plan`` / ``time_limit`` without a plan), 4 the method failed (``error``); ``verify`` 1 for an
-invalid plan; 130 interrupted.
+invalid plan; ``report --strict`` 1 when the report lists a conflict; 130 interrupted.
 A reader that closes stdout early (``| head``) ends the output quietly; the exit code stays the
 command's.
 """
@@ -353,6 +353,8 @@ def _add_report(sub):
     p = sub.add_parser("report", help="gap report (Markdown, HTML, PNG, CSV) from a results directory")
     p.add_argument("results", help="results directory written by `sarcover bench`")
     p.add_argument("-o", "--output", help="report directory (default RESULTS/report)")
+    p.add_argument("--strict", action="store_true", help="exit 1 when the report lists a conflict (a wrong optimum "
+                                                         "or bound), each on a line of stderr")
     p.set_defaults(func=_cmd_report)
 
 
@@ -362,6 +364,28 @@ def _cmd_report(args) -> int:
     out = Path(args.output) if args.output else Path(args.results) / "report"
     summary = write_report(args.results, out)
     _print(summary)
+    if args.strict:
+        return _report_conflicts(args.results)
+    return EXIT_OK
+
+
+EXIT_CONFLICT = 1  # report --strict: the report lists a conflict
+
+
+def _report_conflicts(results) -> int:
+    """``report --strict``: each instance with a conflict (a wrong optimum or bound, as the report's
+    consistency checks find them) on a line of stderr, and exit 1; exit 0 without one."""
+    from sarcover.reports.gaps import instance_table
+    from sarcover.reports.results import load_results
+
+    df, _skipped = load_results(results)
+    conflicts = instance_table(df)["conflict"]
+    conflicts = conflicts[conflicts != ""]
+    for name, what in conflicts.items():
+        _note(f"conflict on {name}: {what}")
+    if len(conflicts):
+        _note(f"report --strict: {_plural(len(conflicts), 'instance')} with a conflict (a wrong optimum or bound)")
+        return EXIT_CONFLICT
     return EXIT_OK
 
 
@@ -425,7 +449,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="sarcover", description="Exact and heuristic benchmarking for multi-view SAR-UAV coverage "
                      "planning", epilog=EXIT_CODES.replace("exit codes:", "exit codes of `sarcover solve`:")
                      + "\nevery other command exits 0 on success and 2 on bad input; `verify` exits 1 for an "
-                     "invalid plan.",
+                     "invalid plan,\n`report --strict` 1 when the report lists a conflict.",
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"sarcover {_version()}")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser, required=True)
