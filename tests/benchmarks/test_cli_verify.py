@@ -4,6 +4,7 @@ line (exit 1), bad input in one line (exit 2)."""
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -158,3 +159,16 @@ def test_results_folder_gives_the_optimum_a_run_proved(tmp_path, capsys):
     assert main(["verify", str(other), str(tmp_path / "p.json"), "--results", str(tmp_path / "r")]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[1].startswith("no optimum or bound known") and lines[2].endswith("none of its 1 runs is on this instance")
+
+
+def test_exit_codes_are_documented_in_help_and_readme(capsys):
+    """`verify --help` lists its exit codes 0, 1, 2; the README's exit-code table has the lines of
+    `verify` and `report --strict`, and its plan file section the format tag."""
+    assert main(["verify", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "0 a valid plan" in text and "1 an invalid plan" in text and "2 bad input" in text
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    section = readme[readme.index("### Exit codes"):]
+    section = section[:section.index("\n## ")]
+    assert "| 1 | `verify`: the plan is invalid" in section and "| 1 | `report --strict`: " in section
+    assert '"format": "sarcover-plan", "version": 1' in readme
