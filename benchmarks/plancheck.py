@@ -97,7 +97,7 @@ class PlanCheck:
         else:
             covered = f"prize {obj:g} of {self.total_prize:g}, {self.report.covered} of {self.n_nodes} nodes"
         most = max(self.report.energy, default=0.0)
-        head = (f"valid plan for {self.instance}: objective {obj:g}, coverage {100 * self.coverage:.2f} % "
+        head = (f"valid plan for {self.instance}: objective {obj:g}, coverage {100 * self.coverage:.2f}% "
                 f"({covered}), energy per route at most {most:.6g} of {self.budget:g}")
         return [head, self._gap_line(), *self.notes]
 
@@ -108,7 +108,7 @@ class PlanCheck:
         if known.kind == "infeasible":
             return (f"CONFLICT: {known.source} says no plan covers every target, and this one does: "
                     "that proof is wrong")
-        pct = f"{100 * gap:.2f} %" if math.isfinite(gap) else "unbounded"
+        pct = f"{100 * gap:.2f}%" if math.isfinite(gap) else "unbounded"
         if known.kind == "optimum":
             line = f"gap {pct} to the proven optimum {known.value:g} ({known.source})"
             if gap < -TOL:
@@ -120,7 +120,7 @@ class PlanCheck:
                 line += "; CONFLICT: the plan is better than the bound, so that bound is wrong"
             return line
         if gap < -TOL:
-            return (f"above the published best known value {known.value:g} by {100 * -gap:.2f} % ({known.source}; "
+            return (f"above the published best known value {known.value:g} by {100 * -gap:.2f}% ({known.source}; "
                     "not proven optimal): a new best known value")
         return f"{pct} below the best known value {known.value:g} ({known.source}; not proven optimal)"
 
@@ -130,7 +130,8 @@ class PlanCheck:
         return {
             "instance": self.instance, "valid": self.valid, "violations": self.violations,
             "objective": self.objective, "coverage": self.coverage,
-            "covered": self.report.covered if self.valid else None, "energy": self.report.energy,
+            "covered": self.report.covered if self.valid else None,
+            "energy": [e if math.isfinite(e) else None for e in self.report.energy],  # NaN is not JSON
             "known": None if self.known is None else {"kind": self.known.kind, "value": self.known.value,
                                                       "source": self.known.source},
             "gap": gap if gap is None or math.isfinite(gap) else None,

@@ -46,7 +46,7 @@ def test_solve_plan_out_round_trips_through_verify(tmp_path, inst_file, capsys):
     assert main(["verify", str(inst_file), str(plan)]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith(f"valid plan for sar-m6-k2-n2-s1501: objective {solved['objective']:g}, coverage")
-    assert lines[1].startswith(f"gap {100 * check['gap']:.2f} % to the proven optimum 7 (regression table")
+    assert lines[1].startswith(f"gap {100 * check['gap']:.2f}% to the proven optimum 7 (regression table")
 
 
 def test_shipped_top_benchmark_by_name_gets_its_published_optimum(tmp_path, capsys):

@@ -42,7 +42,7 @@ def test_best_bound_when_no_optimum_is_proven(tmp_path, sar):
     assert check.valid and check.objective == 5.0
     assert (check.known.kind, check.known.value) == ("bound", 8.0) and check.known.source.endswith("proven by bp")
     assert check.gap == pytest.approx(3 / 8)
-    assert check.lines()[1].startswith("gap at most 37.50 % to the best proven bound 8")
+    assert check.lines()[1].startswith("gap at most 37.50% to the best proven bound 8")
 
 
 def test_disagreeing_optima_and_a_plan_above_the_optimum_are_conflicts(tmp_path, sar):
@@ -62,7 +62,7 @@ def test_published_best_known_value_of_a_shipped_file():
     known = known_value(inst)
     assert known.kind == "best_known" and known.value == 590.0
     check = check_plan(inst, Plan.of([[0]]))
-    assert check.valid and check.lines()[1].startswith(f"{100 * (590 - check.objective) / 590:.2f} % below the best known")
+    assert check.valid and check.lines()[1].startswith(f"{100 * (590 - check.objective) / 590:.2f}% below the best known")
 
 
 def test_regression_infeasible_row_and_content_match():
@@ -83,3 +83,10 @@ def test_to_dict_is_json_and_matches_the_check(sar):
     data = json.loads(json.dumps(check_plan(sar, PLAN).to_dict()))
     assert data["valid"] and data["objective"] == 5.0 and data["known"] is None and data["gap"] is None
     assert np.allclose(data["energy"], check_plan(sar, PLAN).report.energy)
+
+
+def test_to_dict_of_a_plan_with_unknown_nodes_is_strict_json(sar):
+    """A Plan built in Python with an id that names no node: invalid, and its object has no NaN."""
+    data = check_plan(sar, Plan.of([[0, 99]])).to_dict()
+    assert not data["valid"] and "route 0 visits unknown node 99" in data["violations"]
+    assert data["energy"] == [None] and json.loads(json.dumps(data, allow_nan=False)) == data
