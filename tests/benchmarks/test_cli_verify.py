@@ -10,7 +10,6 @@ import pytest
 
 from sarcover.benchmarks.cli import main
 from sarcover.formulations.generate import generate
-from sarcover.formulations.instance import to_top
 from sarcover.formulations.io import load_instance, save_json
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.planfile import save_plan

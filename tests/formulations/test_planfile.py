@@ -78,8 +78,8 @@ def good(**changes):
     (good(routes=[[0, 1.0]]), "field 'routes[0][1]' must be an integer node id, got 1"),
     (good(routes=[[0, "1"]]), "field 'routes[0][1]' must be an integer node id, got '1'"),
     (good(routes=[[True]]), "field 'routes[0][0]' must be an integer node id, got True"),
-    (good(routes=[[0], [12]]), "field 'routes[1][0]' is 12, not a node id (instance 'sar-m4-k3-n2-s5' has "
-                               "viewpoints 0..11)"),
+    (good(routes=[[0], [12]]), ("field 'routes[1][0]' is 12, not a node id (instance 'sar-m4-k3-n2-s5' has "
+                                "viewpoints 0..11)")),
     (good(routes=[[-1]]), "field 'routes[0][0]' is -1, not a node id"),
 ])
 def test_bad_plans_are_refused_naming_the_field(sar, data, message):
