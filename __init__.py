@@ -20,8 +20,13 @@ Instances
     :class:`TOPInstance`.
 Methods and results
     :func:`list_methods`, :func:`solve` (any registered method; returns a
-    :class:`VerifiedResult`), :func:`verify`, :class:`Plan`, :class:`Termination` (why a run
-    stopped), :class:`SolutionStatus` (what it found), :class:`Status` (both in one word).
+    :class:`VerifiedResult`), :func:`verify`, :class:`Plan`, :class:`Result` (what a method of
+    one's own returns), :class:`Termination` (why a run stopped), :class:`SolutionStatus` (what it
+    found), :class:`Status` (both in one word).
+Plans from outside
+    :func:`read_plan` and :func:`write_plan` (plan files, the format of ``sarcover verify``),
+    :func:`verify_plan` (violations, or objective, coverage and gap to the known optimum or
+    bound: a :class:`PlanCheck`).
 Benchmarks and reports
     :func:`run_suite` (locally or on a Dask scheduler), :func:`load_results` (a pandas
     DataFrame, one row per job), :func:`gap_tables` (per-method and per-instance gaps),
@@ -37,9 +42,10 @@ from __future__ import annotations
 from importlib.metadata import PackageNotFoundError, version as _version
 from pathlib import Path
 
+from sarcover.benchmarks.plancheck import PlanCheck
 from sarcover.formulations.instance import SARInstance, TOPInstance, to_top
 from sarcover.formulations.plan import Plan
-from sarcover.formulations.result import SolutionStatus, Status, Termination, VerifiedResult
+from sarcover.formulations.result import Result, SolutionStatus, Status, Termination, VerifiedResult
 from sarcover.formulations.verify import VerificationReport, verify
 
 try:
@@ -49,8 +55,9 @@ except PackageNotFoundError:  # pragma: no cover - running from a checkout that 
 
 __all__ = [
     "SARInstance", "TOPInstance", "generate", "read_instance", "to_top",
-    "Plan", "Termination", "SolutionStatus", "Status", "VerifiedResult", "VerificationReport",
+    "Plan", "Result", "Termination", "SolutionStatus", "Status", "VerifiedResult", "VerificationReport",
     "list_methods", "solve", "verify",
+    "read_plan", "write_plan", "verify_plan", "PlanCheck",
     "run_suite", "load_results", "gap_tables", "write_report", "plot_plan",
 ]
 
@@ -92,6 +99,49 @@ def solve(instance: SARInstance | TOPInstance, method: str = "greedy", *, seed: 
     get_method(method)  # an unknown name is the caller's mistake: raise it here
     top = to_top(instance) if isinstance(instance, SARInstance) else instance
     return run_method(method, top, seed=seed, time_limit=time_limit)
+
+
+def read_plan(path: str | Path, instance: SARInstance | TOPInstance | None = None) -> Plan:
+    """The plan in the plan file at ``path`` (README, "Plan files"); with ``instance``, checked to
+    name that instance and only its node ids. Bad input raises a one-line error."""
+    from sarcover.formulations.planfile import load_plan
+
+    top = to_top(instance) if isinstance(instance, SARInstance) else instance
+    return load_plan(path, top).plan
+
+
+def write_plan(plan: Plan, path: str | Path, instance: SARInstance | TOPInstance, method: str | None = None) -> None:
+    """Write ``plan`` (a :class:`Plan`, or a list of routes of node ids) on ``instance`` as a plan
+    file, naming the ``method`` that made it if given."""
+    from sarcover.formulations.planfile import save_plan
+
+    save_plan(plan if isinstance(plan, Plan) else Plan.of(plan), path, instance.name, method)
+
+
+def verify_plan(instance, plan, *, results: str | Path | None = None):
+    """Check a plan from outside, as ``sarcover verify`` does: ``instance`` is an instance or
+    what :func:`read_instance` reads, ``plan`` a :class:`Plan`, a list of routes of node ids, or
+    a plan file. Returns a :class:`PlanCheck`: ``valid``, ``violations``, ``objective``,
+    ``coverage``, ``known`` (the proven optimum, infeasibility, best bound or best known value
+    sarcover knows, with its source; ``results`` adds the runs of a results folder) and ``gap``.
+    Bad input (a missing or malformed file, ids that name no node) raises a one-line error."""
+    from sarcover.benchmarks.plancheck import check_plan
+    from sarcover.formulations.planfile import load_plan
+
+    if isinstance(instance, SARInstance):
+        top = to_top(instance)
+    elif isinstance(instance, TOPInstance):
+        top = instance
+    else:
+        top = read_instance(instance)
+    if isinstance(plan, (str, Path)):
+        plan = load_plan(plan, top).plan
+    elif not isinstance(plan, Plan):
+        from sarcover.formulations.planfile import plan_from_dict
+
+        plan = plan_from_dict({"format": "sarcover-plan", "version": 1, "instance": top.name,
+                               "routes": [list(r) for r in plan]}, top, source="routes").plan
+    return check_plan(top, plan, results)
 
 
 def run_suite(suite, out_dir: str | Path | None = None, *, workers: int | None = None, resume: bool = False,

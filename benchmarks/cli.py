@@ -2,7 +2,8 @@
 
 Exit codes (README, "Exit codes"): 0 success (for ``solve``: a verified plan came back); 2 bad
 input, with one line on stderr naming the problem; ``solve`` only: 3 no plan (``infeasible``, or
-``no_plan`` / ``time_limit`` without a plan), 4 the method failed (``error``); 130 interrupted.
+``no_plan`` / ``time_limit`` without a plan), 4 the method failed (``error``); ``verify`` 1 for an
+invalid plan; ``report --strict`` 1 when the report lists a conflict; 130 interrupted.
 A reader that closes stdout early (``| head``) ends the output quietly; the exit code stays the
 command's.
 """
@@ -186,6 +187,7 @@ def _add_solve(sub):
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", help="write a picture of the plan (paper's Fig. 2 style; PNG unless the name says "
                                   "pdf, svg, ...)")
+    p.add_argument("--plan-out", metavar="FILE", help="write the plan as a plan file (read by `sarcover verify`)")
     p.set_defaults(func=_cmd_solve)
 
 
@@ -208,6 +210,7 @@ def _cmd_solve(args) -> int:
 
     spec = get_method(args.method)
     plot = _plot_file(args.plot) if args.plot else None
+    plan_out = _output_file(args.plan_out, "--plan-out") if args.plan_out else None
     instance = load_instance(instance_path(args.file))
     check_size(spec, instance.n_nodes, instance.n_vehicles)  # refused before the method allocates it
     if spec.warm_up is not None:  # a pause of ~30 s on a fresh checkout deserves a word
@@ -218,6 +221,8 @@ def _cmd_solve(args) -> int:
     record = {**outcome(run, instance), "exact": spec.exact}
     if plot is not None:
         _write_plot(instance, run, record, plot)
+    if plan_out is not None:
+        _write_plan(instance, run, plan_out)
     if args.json:
         _print(json.dumps(record))
     else:
@@ -261,6 +266,29 @@ def _write_plot(instance, run, record, path):
         raise CLIError(f"--plot: cannot write {path} ({exc.strerror or exc})") from None
     finally:
         plt.close(fig)
+
+
+def _write_plan(instance, run, path) -> None:
+    """Write the run's plan as a plan file (also a plan the verifier rejected, so that `sarcover
+    verify` can show why); a run without a plan writes nothing. Says so on stderr."""
+    from sarcover.formulations.planfile import save_plan
+
+    if run.plan is None:
+        _note(f"no plan: nothing written to {path}")
+        return
+    try:
+        save_plan(run.plan, path, instance.name, run.method)
+    except OSError as exc:
+        raise CLIError(f"--plan-out: cannot write {path} ({exc.strerror or exc})") from None
+    _note(f"plan written to {path}")
+
+
+def _note(text: str) -> None:
+    """A line on stderr, so that stdout stays one JSON object with --json."""
+    try:
+        print(text, file=sys.stderr, flush=True)
+    except OSError:  # nobody reads stderr: the exit code still says how the command went
+        pass
 
 
 def _summary(instance, spec, rec) -> str:
@@ -325,6 +353,8 @@ def _add_report(sub):
     p = sub.add_parser("report", help="gap report (Markdown, HTML, PNG, CSV) from a results directory")
     p.add_argument("results", help="results directory written by `sarcover bench`")
     p.add_argument("-o", "--output", help="report directory (default RESULTS/report)")
+    p.add_argument("--strict", action="store_true", help="exit 1 when the report lists a conflict (a wrong optimum "
+                                                         "or bound), each on a line of stderr")
     p.set_defaults(func=_cmd_report)
 
 
@@ -334,11 +364,76 @@ def _cmd_report(args) -> int:
     out = Path(args.output) if args.output else Path(args.results) / "report"
     summary = write_report(args.results, out)
     _print(summary)
+    if args.strict:
+        return _report_conflicts(args.results)
     return EXIT_OK
 
 
+EXIT_CONFLICT = 1  # report --strict: the report lists a conflict
+
+
+def _report_conflicts(results) -> int:
+    """``report --strict``: each instance with a conflict (a wrong optimum or bound, as the report's
+    consistency checks find them) on a line of stderr, and exit 1; exit 0 without one."""
+    from sarcover.reports.gaps import instance_table
+    from sarcover.reports.results import load_results
+
+    df, _skipped = load_results(results)
+    conflicts = instance_table(df)["conflict"]
+    conflicts = conflicts[conflicts != ""]
+    for name, what in conflicts.items():
+        _note(f"conflict on {name}: {what}")
+    if len(conflicts):
+        _note(f"report --strict: {_plural(len(conflicts), 'instance')} with a conflict (a wrong optimum or bound)")
+        return EXIT_CONFLICT
+    return EXIT_OK
+
+
+# -- verify -------------------------------------------------------------------------------------
+EXIT_INVALID_PLAN = 1  # verify: the plan breaks a constraint
+
+
+def _add_verify(sub):
+    p = sub.add_parser(
+        "verify", help="check a plan file against an instance: its violations, or its objective and gap",
+        description=textwrap.fill(
+            "Check a plan file (`sarcover solve --plan-out`, or one's own: README, \"Plan files\") against an "
+            "instance (sarcover JSON, TOP text file or shipped benchmark name). A valid plan: its objective, "
+            "coverage, and gap to the instance's proven optimum or best bound where sarcover knows one (shipped "
+            "TOP values, the regression table, or the runs in --results DIR). An invalid plan: each violation "
+            "on a line.", 78),
+        epilog=f"""exit codes:
+  {EXIT_OK}    a valid plan
+  {EXIT_INVALID_PLAN}    an invalid plan (each violation on a line of stdout)
+  {EXIT_BAD_INPUT}    bad input (one line on stderr naming the problem)""",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("instance", help="instance: sarcover JSON file, TOP text file, or shipped benchmark name (p2.3.g)")
+    p.add_argument("plan", help="plan file (JSON: format sarcover-plan)")
+    p.add_argument("--results", metavar="DIR", help="a results folder (`sarcover bench`) whose runs on the "
+                                                    "instance give its optimum or best bound")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_cmd_verify)
+
+
+def _cmd_verify(args) -> int:
+    from sarcover.benchmarks.catalog import instance_path
+    from sarcover.benchmarks.plancheck import check_plan
+    from sarcover.formulations.io import load_instance
+    from sarcover.formulations.planfile import load_plan
+
+    instance = load_instance(instance_path(args.instance))
+    plan = load_plan(args.plan, instance)
+    check = check_plan(instance, plan.plan, args.results)
+    if args.json:
+        _print(json.dumps(check.to_dict()))
+    else:
+        for line in check.lines():
+            _print(line)
+    return EXIT_OK if check.valid else EXIT_INVALID_PLAN
+
+
 # -- main ---------------------------------------------------------------------------------------
-COMMANDS = [_add_generate, _add_solve, _add_methods, _add_bench, _add_report]
+COMMANDS = [_add_generate, _add_solve, _add_methods, _add_bench, _add_report, _add_verify]
 
 
 def _version() -> str:
@@ -353,7 +448,8 @@ def _version() -> str:
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="sarcover", description="Exact and heuristic benchmarking for multi-view SAR-UAV coverage "
                      "planning", epilog=EXIT_CODES.replace("exit codes:", "exit codes of `sarcover solve`:")
-                     + "\nevery other command exits 0 on success and 2 on bad input.",
+                     + "\nevery other command exits 0 on success and 2 on bad input; `verify` exits 1 for an "
+                     "invalid plan,\n`report --strict` 1 when the report lists a conflict.",
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"sarcover {_version()}")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser, required=True)
