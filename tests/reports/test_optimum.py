@@ -194,9 +194,7 @@ def test_top_sets_in_the_reference_report(tmp_path):
     assert (tmp_path / "out" / "top_4_7_sets.csv").stat().st_size > 0
 
 
-def test_decomposition_section_appears_when_its_rows_exist(tmp_path, monkeypatch):
-    from test_reports_decomposition import synthetic_rows
-
+def test_decomposition_section_appears_when_its_rows_exist(tmp_path, monkeypatch, synthetic_rows):
     from sarcover.reports import decomposition
     from sarcover.reports.style import look
 
