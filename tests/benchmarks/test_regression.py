@@ -103,6 +103,22 @@ def test_add_replaces_rows_of_the_same_spec(tmp_path, monkeypatch):
     assert next(r for r in rows if r["spec"] == spec)["confirmed_by"] == "bp+milp"
 
 
+def test_cli_default_output_is_under_the_current_directory_not_the_package(tmp_path, monkeypatch, capsys):
+    """Without --out the command writes results/regression/optimal_values.csv under the current
+    directory, from the shipped table plus the new row, and leaves the shipped table alone."""
+    shipped = TABLE.read_bytes()
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(regression, "confirm", lambda s, t, by: {
+        "spec": s, "status": "optimal", "value": "7", "confirmed_by": by, "bp_s": "0.1"})
+    assert regression.main(["--add", "top:p2.2.a", "--by", "bp+milp"]) == 0
+    out = tmp_path / "results" / "regression" / "optimal_values.csv"
+    assert f"written to {regression.OUT}" in capsys.readouterr().out
+    rows = read_table(out)
+    assert TABLE.read_bytes() == shipped
+    assert {r["spec"] for r in rows} == {r["spec"] for r in ROWS} | {"top:p2.2.a"}
+    assert next(r for r in rows if r["spec"] == "top:p2.2.a")["value"] == "7"
+
+
 def test_cli_bad_spec_is_one_line(capsys):
     assert regression.main(["--add", "nonsense:1", "--out", "/dev/null"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
