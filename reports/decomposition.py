@@ -20,14 +20,11 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from sarcover.reports.style import look  # noqa: E402
+from sarcover.reports.plots import subplots
+from sarcover.reports.style import look
 
 PARTS = [("clustering_loss", "clustering loss", "tab:blue"),
          ("cross_cluster", "cross-cluster part (repair/refill moves)", "tab:gray"),
@@ -136,7 +133,7 @@ def plot_decomposition(tab: pd.DataFrame, path: Path) -> None:
     """Stacked bars per setting: mean clustering loss, cross-cluster part and routing loss (% of
     OPT) per method; a negative cross-cluster part is drawn below zero; the dot is the mean gap."""
     settings = list(dict.fromkeys(tab["setting"]))
-    fig, axes = plt.subplots(1, len(settings), figsize=(max(5.5, 3.4 * len(settings)) + 1, 4.6), squeeze=False,
+    fig, axes = subplots(1, len(settings), figsize=(max(5.5, 3.4 * len(settings)) + 1, 4.6), squeeze=False,
                              sharey=True)
     for ax, setting in zip(axes[0], settings):
         t = tab[tab["setting"] == setting]
@@ -162,7 +159,6 @@ def plot_decomposition(tab: pd.DataFrame, path: Path) -> None:
     fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=len(labels), frameon=False)
     fig.tight_layout(rect=(0, 0.07, 1, 1))
     fig.savefig(path, dpi=130)
-    plt.close(fig)
 
 
 def _fmt(v, digits=1) -> str:

@@ -23,16 +23,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from sarcover.reports.gaps import add_gaps, instance_table  # noqa: E402
-from sarcover.reports.plots import save_figure  # noqa: E402
-from sarcover.reports.style import PAPER, PEERS, dodge, legend_outside, look  # noqa: E402
+from sarcover.reports.gaps import add_gaps, instance_table
+from sarcover.reports.plots import save_figure, subplots
+from sarcover.reports.style import PAPER, PEERS, dodge, legend_outside, look
 
 SUITE = "paper-opt"
 PROVER = "bp"  # the exact method of the suite: its proofs and bounds make the optimum
@@ -254,7 +250,7 @@ def draw_optimum(ax, curve: pd.DataFrame, x: str, width: float = 0.45) -> list:
 
 def plot_sweep(cov: pd.DataFrame, curve: pd.DataFrame, sweep: Sweep, path) -> list[str]:
     """One figure: each method's mean coverage (95 % CI) in its look, and the mean optimum."""
-    fig, ax = plt.subplots(figsize=(8.5, 4.5))
+    fig, ax = subplots(figsize=(8.5, 4.5))
     extra = draw_optimum(ax, curve, sweep.x)
     methods = [m for m in METHODS if m in set(cov["method"])]
     methods += sorted(set(cov["method"]) - set(methods))

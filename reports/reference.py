@@ -19,19 +19,15 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from sarcover.reports.decomposition import write_decomposition  # noqa: E402
-from sarcover.reports.optimum import optimum_section  # noqa: E402
-from sarcover.reports.plots import save_figure  # noqa: E402
-from sarcover.reports.results import load_results  # noqa: E402
-from sarcover.reports.style import PAPER, PEERS, dodge, legend_outside, look  # noqa: E402
-from sarcover.reports.top_sets import top_sets_section  # noqa: E402
+from sarcover.reports.decomposition import write_decomposition
+from sarcover.reports.optimum import optimum_section
+from sarcover.reports.plots import save_figure, subplots
+from sarcover.reports.results import load_results
+from sarcover.reports.style import PAPER, PEERS, dodge, legend_outside, look
+from sarcover.reports.top_sets import top_sets_section
 
 ORDER = PAPER + PEERS  # the heuristics, in the order of every table and legend
 LONG_BP = "bp-300s"  # bp rows of the suite paper-gaps-long
@@ -84,7 +80,7 @@ def _sweep(df: pd.DataFrame, x: str, out: Path, name: str, title: str, peers: pd
     tab = pd.DataFrame({"mean": g["cov0"].mean(), "ci95": g["cov0"].apply(_ci), "runs": g.size(),
                         "with_plan": g["has_plan"].mean()}).reset_index()
     tab.to_csv(out / f"{name}.csv", index=False)
-    fig, ax = plt.subplots(figsize=(8.5, 4.5))
+    fig, ax = subplots(figsize=(8.5, 4.5))
     methods = [m for m in ORDER if m in set(tab["method"])]
     shift = dodge(methods, 0.05)  # equal means side by side (x is a count: N or K)
     runs = {}
@@ -295,7 +291,7 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
         t = pd.DataFrame({"mean": g["cov0"].mean(), "ci95": g["cov0"].apply(_ci), "runs": g.size(),
                           "with_plan": g["has_plan"].mean()}).reset_index()
         t.to_csv(out / "coverage_vs_emax.csv", index=False)
-        fig, ax = plt.subplots(figsize=(8.5, 4.5))
+        fig, ax = subplots(figsize=(8.5, 4.5))
         methods = [m for m in ORDER if m in set(t["method"])]
         budgets = sorted(t["e_max"].unique())
         shift = dodge(methods, 0.05 * (min(np.diff(budgets)) if len(budgets) > 1 else 1.0))
@@ -561,7 +557,7 @@ def _routes(pk: pd.DataFrame, peers: pd.DataFrame | None, out: Path) -> list[str
         return []
     rows = rows.set_index("method").reindex([m for m in ORDER if m in set(rows["method"])])
     inst = to_top(generate(20, 3, 5, 0))
-    fig, axes = plt.subplots(2, 4, figsize=(20, 10.6), squeeze=False)
+    fig, axes = subplots(2, 4, figsize=(20, 10.6), squeeze=False)
     for ax, (m, r) in zip(axes.flat, rows.iterrows()):
         plot_plan(inst, Plan.of(r["routes"]), ax=ax, title=f"{m}: coverage {100 * r['coverage']:.1f}%",
                   legend=False)

@@ -17,8 +17,6 @@ from sarcover.reports.optimum import SWEEPS, brackets, method_gaps, optimum_curv
 from sarcover.reports.reference import write_reference
 from sarcover.reports.top_sets import file_table, set_table, top_sets_section
 
-matplotlib.use("Agg")
-
 
 def row(instance, method, status, objective, bound=None, *, K=3, N=2, M=20, **extra) -> dict:
     """One result row of the fields the report reads."""
@@ -206,7 +204,7 @@ def test_decomposition_section_appears_when_its_rows_exist(tmp_path, monkeypatch
             ticks.update({t.get_text(): matplotlib.colors.to_hex(t.get_color()) for t in ax.get_xticklabels()})
         return savefig(fig, path, *args, **kwargs)
 
-    monkeypatch.setattr(decomposition.plt.Figure, "savefig", record)
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", record)
 
     root = tmp_path / "root"
     text = write_reference(root, tmp_path / "out", suites=SUITES).read_text()

@@ -6,13 +6,12 @@ import json
 
 import matplotlib
 import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from sarcover.benchmarks.harness import run_one
 from sarcover.benchmarks.registry import METHODS
 from sarcover.reports import optimum, reference, report
 from sarcover.reports.style import GROUPS, look, ordered
-
-matplotlib.use("Agg")
 
 
 def test_every_registered_method_has_its_own_colour_and_marker_in_its_group():
@@ -59,7 +58,7 @@ def _figures(monkeypatch, module):
     original = module.save_figure
 
     def record(fig, path, *args, **kwargs):
-        fig.canvas.draw()
+        FigureCanvasAgg(fig).draw()  # the reports' figures belong to no backend: draw them as saved
         seen.append((str(path), fig, _facts(fig)))
         return original(fig, path, *args, **kwargs)
 
