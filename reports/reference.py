@@ -176,7 +176,8 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
     if peers is not None:
         L += [f"pyvrp and routing ran on the first {peers.groupby(['method', 'N', 'K']).size().max()} instances "
               f"of each setting only (time limits: " + ", ".join(
-                  f"{m} {peers[peers['method'] == m]['time_limit'].iloc[0]:g} s" for m in sorted(peers['method'].unique()))
+                  f"{m} {peers[peers['method'] == m]['time_limit'].iloc[0]:g} s"
+                  for m in sorted(peers['method'].unique()))
               + "); their curves are on those instances.", ""]
 
     # -- claims
@@ -306,7 +307,7 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
         ax.grid(alpha=0.3)
         legend_outside(ax, methods, label=lambda m: f"{m} ({runs[m]} runs)")
         save_figure(fig, out / "coverage_vs_emax.png")
-        piv = t.pivot(index="method", columns="e_max", values="mean").reindex([m for m in ORDER if m in set(t["method"])])
+        piv = t.pivot(index="method", columns="e_max", values="mean").reindex(methods)
         pp = piv.loc[[m for m in PAPER if m in piv.index]]
         bestm = {c: (pp[c].idxmax() if pp[c].max() - pp[c].min() > 1e-9 else "all equal") for c in pp.columns}
         L += ["## Sensitivity to E_max", "", "![coverage vs E_max](coverage_vs_emax.png)", "", _md(piv), "",
@@ -370,7 +371,8 @@ def _table1(pk: pd.DataFrame, out: Path) -> pd.DataFrame | None:
     """Median seconds per stage and whole run by K: CPU time where the rows have it, else wall."""
     info = pk["info"].apply(lambda d: d if isinstance(d, dict) else {})
     cpu = _uses_cpu(pk) and info[pk["method"].isin(PAPER)].apply(lambda d: "cpu_route_s" in d).all()
-    kc, kr, whole = ("cpu_cluster_s", "cpu_route_s", "cpu_s") if cpu else ("time_cluster_s", "time_route_s", "runtime_s")
+    kc, kr, whole = (("cpu_cluster_s", "cpu_route_s", "cpu_s") if cpu
+                     else ("time_cluster_s", "time_route_s", "runtime_s"))
     pk = pk.assign(tc=info.apply(lambda d: d.get(kc)), tr=info.apply(lambda d: d.get(kr)))
     rows = {}
     for label, method, col in [("DPC", "dpc-pso", "tc"), ("ADPC", "adpc-pso", "tc"), ("KMeans", "kmeans-pso", "tc"),
@@ -408,8 +410,8 @@ def _gaps_section(ex, pg, out: Path) -> list[str]:
         L += ["### exact-small: gap to the proven optimum", "",
               f"SAR instances with 8-40 viewpoints (suite `exact-small`), {len(inst)} instances, proven optimum on "
               f"{n_opt} of them (by milp, cpsat or bp; exact methods at 60 s). gap = (opt − objective)/opt over runs "
-              "with a plan; gap_ub is the gap to the best bound where no optimum was proven (an upper bound on the true "
-              "gap). Conflicts between methods (two optima, objective above a bound): "
+              "with a plan; gap_ub is the gap to the best bound where no optimum was proven (an upper bound on the "
+              "true gap). Conflicts between methods (two optima, objective above a bound): "
               f"{int(inst['conflict'].astype(str).str.len().gt(0).sum())}.", "",
               _md(mt[cols]), ""]
     if pg is not None:
@@ -428,9 +430,9 @@ def _gaps_section(ex, pg, out: Path) -> list[str]:
         t.to_csv(out / "gaps_paper_scale.csv", index=False)
         g[["instance", "method", "status", "objective", "bound", "best_bound", "gap_any", "gap_lb", "coverage",
            "runtime_s"]].sort_values(["instance", "method"]).to_csv(out / "runs_paper_gaps.csv", index=False)
-        piv = pd.concat([t.pivot(index="method", columns="K", values="gap_ub_mean").add_prefix("gap ≤ (to bound), K="),
-                         t.pivot(index="method", columns="K", values="gap_lb_mean").add_prefix("gap ≥ (to best plan), K=")],
-                        axis=1)
+        upper = t.pivot(index="method", columns="K", values="gap_ub_mean").add_prefix("gap ≤ (to bound), K=")
+        lower = t.pivot(index="method", columns="K", values="gap_lb_mean").add_prefix("gap ≥ (to best plan), K=")
+        piv = pd.concat([upper, lower], axis=1)
         piv = piv.reindex([m for m in ["bp", LONG_BP] + ORDER if m in piv.index])
         piv.index.name = "method"
         bb = inst["best_bound"].astype(float)
@@ -442,10 +444,9 @@ def _gaps_section(ex, pg, out: Path) -> list[str]:
               f"Suite `paper-gaps`: {len(inst)} instances (K=3 and K=6, instance seeds 0..7), bp (branch-and-price, "
               f"the strongest bounds here) with a 60 s limit: a bound on {nb} of {len(inst)} instances; "
               f"bp statuses: {bp['status'].value_counts().to_dict()}. Per K, mean bound "
-              + ", ".join(f"K={k}: {inst.loc[inst.index.str.contains(f'-k{k}-'), 'best_bound'].astype(float).mean():.1f} "
-                          f"of {20 * k} viewpoints" for k in sorted(pg['K'].unique()))
-              + ". The gap (bound − objective)/bound is an upper bound on the true gap (it includes the bound's own slack); "
-              f"where an instance has no bound it has no gap. Conflicts (a plan above a bound): {n_conf}. "
+              + ", ".join(f"K={k}: {_mean_bound(inst, k):.1f} of {20 * k} viewpoints" for k in sorted(pg['K'].unique()))
+              + ". The gap (bound − objective)/bound is an upper bound on the true gap (it includes the bound's own "
+              f"slack); where an instance has no bound it has no gap. Conflicts (a plan above a bound): {n_conf}. "
               + _bp_run_summary(bp)
               + (f"Suite `paper-gaps-long` (row `{LONG_BP}`): bp again with a 300 s limit (subset-row cuts on) on "
                  f"{long_bp['instance'].nunique()} of these instances; its bounds count as the instances' bounds "
@@ -453,7 +454,8 @@ def _gaps_section(ex, pg, out: Path) -> list[str]:
                  + _bp_run_summary(long_bp).replace("bp: ", f"{LONG_BP}: ", 1) if len(long_bp) else "") +
               "The gap to the best plan any method found on the instance, (best − objective)/best, is a LOWER "
               "bound on the true gap; the truth lies between the two columns. bp's own row is its incumbent.",
-              "", _md(piv), "", "Tables: `gaps_paper_scale.csv`; every run: `runs_paper_gaps.csv`, `runs_exact_small.csv`.", ""]
+              "", _md(piv), "",
+              "Tables: `gaps_paper_scale.csv`; every run: `runs_paper_gaps.csv`, `runs_exact_small.csv`.", ""]
     return L
 
 
@@ -500,9 +502,10 @@ def _top_section(top: pd.DataFrame | None, out: Path) -> list[str]:
     new = []
     for name, g in open_.groupby("instance"):
         opt = g[g["status"] == "optimal"]
+        open_text = (f"not proven (best bound {g['bound'].astype(float).min():g}, "
+                     f"best plan {g['objective'].astype(float).max():g})")
         new.append(f"{name}: " + (", ".join(f"{m} proves {v:g}" for m, v in zip(opt["method"], opt["objective"]))
-                                  if len(opt) else "not proven (best bound "
-                                  f"{g['bound'].astype(float).min():g}, best plan {g['objective'].astype(float).max():g})"))
+                                  if len(opt) else open_text))
     return ["## Exact solvers on the TOP benchmark (Chao, Golden & Wasil sets 1-3)", "",
             f"Suite `top-chao` with its exact methods, time limit {', '.join(f'{x:g}' for x in limits)} s, one "
             f"thread each: files per set {files}. An instance counts as proven when the method reports "
@@ -525,6 +528,11 @@ def _decomposition_section(root: Path, out: Path) -> list[str]:
              "step): OPT per instance is bp's proven optimum there, else its certified bound; where OPT is a bound "
              "the gap and the clustering loss are upper bounds (the tables say where).")
     return [head, "", intro, "", "![gap decomposition](decomposition.png)", "", rest.lstrip("\n"), ""]
+
+
+def _mean_bound(inst: pd.DataFrame, k: int) -> float:
+    """The mean best bound of the instances with K = ``k`` (their names hold ``-k<K>-``)."""
+    return inst.loc[inst.index.str.contains(f"-k{k}-"), "best_bound"].astype(float).mean()
 
 
 def _bp_run_summary(bp: pd.DataFrame) -> str:

@@ -73,7 +73,8 @@ def set_table(files: pd.DataFrame) -> pd.DataFrame:
                      "unproven": len(open_), "no_plan": int(open_["objective"].isna().sum()),
                      "certified_gap_mean": open_["certified_gap"].mean() if len(open_) else np.nan,
                      "certified_gap_max": open_["certified_gap"].max() if len(open_) else np.nan,
-                     "conflicts": int(g["conflict"].str.len().gt(0).sum()), "news": int(g["news"].str.len().gt(0).sum())})
+                     "conflicts": int(g["conflict"].str.len().gt(0).sum()),
+                     "news": int(g["news"].str.len().gt(0).sum())})
     return pd.DataFrame(rows)
 
 
@@ -87,7 +88,8 @@ def _table(st: pd.DataFrame) -> list[str]:
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in st.to_dict("records"):  # per column types (iterrows makes every count a float)
         lines.append(f"| {r['set']} | {r['files']} | {r['published_optima']} ({r['best_known_only']}) | "
-                     f"{r['bp_proven']} ({_pct(r['share_proven'])}) | {r['proven_equal_published']} | {r['new_proofs']} | "
+                     f"{r['bp_proven']} ({_pct(r['share_proven'])}) | {r['proven_equal_published']} | "
+                     f"{r['new_proofs']} | "
                      + ("–" if pd.isna(r["median_s_proven"]) else f"{r['median_s_proven']:.0f}")
                      + f" | {r['unproven']}" + (f" ({r['no_plan']} without plan)" if r["no_plan"] else "")
                      + f" | {_pct(r['certified_gap_mean'])} / {_pct(r['certified_gap_max'])} | "

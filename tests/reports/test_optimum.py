@@ -13,7 +13,7 @@ import pytest
 
 from sarcover.benchmarks.reproduce import DECOMPOSE_SETTINGS, DECOMPOSITION, EXACT_ONLY, STEPS, SUITES
 from sarcover.reports import optimum
-from sarcover.reports.optimum import SWEEPS, brackets, method_gaps, optimum_curve, setting_table
+from sarcover.reports.optimum import SWEEPS, brackets, method_gaps, setting_table
 from sarcover.reports.reference import write_reference
 from sarcover.reports.top_sets import file_table, set_table, top_sets_section
 
@@ -99,7 +99,8 @@ def test_band_where_unproven_line_where_proven(tmp_path, monkeypatch):
     monkeypatch.setattr(optimum, "save_figure", lambda fig, path, *a, **k: figures.append((path.name, fig)))
     text = "\n".join(optimum.optimum_section(df, tmp_path))
     [(name, fig)] = figures  # Fig. 4 has no rows (no N=5): no figure, said in the text
-    assert name == "paper_opt_vs_N.png" and "Fig. 4 with the optimum: coverage against K (M=20, N=5): no rows yet" in text
+    assert name == "paper_opt_vs_N.png"
+    assert "Fig. 4 with the optimum: coverage against K (M=20, N=5): no rows yet" in text
     ax = fig.axes[0]
     [line] = [ln for ln in ax.get_lines() if ln.get_label() == "optimum"]
     assert line.get_ydata()[0] == pytest.approx(0.5) and np.isnan(line.get_ydata()[1])
@@ -166,12 +167,14 @@ def top_rows() -> list[dict]:
 def test_top_sets_flag_conflicts_and_news(tmp_path):
     files = file_table(pd.DataFrame(top_rows()))
     assert files.loc["p4.2.a", "proven_equal"] and not files.loc["p4.2.b", "proven_equal"]
-    assert "disagree" in files.loc["p4.2.b", "conflict"] and "below published optimum" in files.loc["p5.2.a", "conflict"]
+    assert "disagree" in files.loc["p4.2.b", "conflict"]
+    assert "below published optimum" in files.loc["p5.2.a", "conflict"]
     assert files.loc["p4.2.a", "conflict"] == "" and files.loc["p7.2.a", "conflict"] == ""
     assert "new best known 410" in files.loc["p5.3.a", "news"] and files.loc["p6.2.a", "new_proof"]
     assert files.loc["p7.2.a", "certified_gap"] == pytest.approx(0.1)
     st = set_table(files).set_index("set")
-    assert st.loc[4, ["files", "published_optima", "bp_proven", "proven_equal_published", "conflicts"]].tolist() == [2, 2, 2, 1, 1]
+    counts = ["files", "published_optima", "bp_proven", "proven_equal_published", "conflicts"]
+    assert st.loc[4, counts].tolist() == [2, 2, 2, 1, 1]
     assert st.loc[5, ["best_known_only", "conflicts", "news", "unproven"]].tolist() == [1, 1, 1, 2]
     assert st.loc[6, "new_proofs"] == 1 and st.loc[7, "certified_gap_max"] == pytest.approx(0.1)
     text = "\n".join(top_sets_section(pd.DataFrame(top_rows()), tmp_path))
@@ -193,7 +196,6 @@ def test_top_sets_in_the_reference_report(tmp_path):
 
 
 def test_decomposition_section_appears_when_its_rows_exist(tmp_path, monkeypatch, synthetic_rows):
-    from sarcover.reports import decomposition
     from sarcover.reports.style import look
 
     ticks = {}
@@ -236,8 +238,10 @@ def test_reproduce_runs_paper_opt_then_decomposition_then_top_4_7(tmp_path, monk
             self.meta = {"K": k, "N": n}
 
     seen = {}
-    monkeypatch.setattr(decomposition, "cases_from_results", lambda src: [Case(k, n) for k in (2, 3, 6) for n in (2, 5)])
-    monkeypatch.setattr(decomposition, "decompose", lambda cases, out, **kw: seen.update(cases=cases, out=out) or [1, 2])
+    monkeypatch.setattr(decomposition, "cases_from_results",
+                        lambda src: [Case(k, n) for k in (2, 3, 6) for n in (2, 5)])
+    monkeypatch.setattr(decomposition, "decompose",
+                        lambda cases, out, **kw: seen.update(cases=cases, out=out) or [1, 2])
     write_rows(tmp_path / "paper-opt", [])
     assert reproduce.decompose_step(tmp_path, quiet=True) == 2
     assert {(c.meta["K"], c.meta["N"]) for c in seen["cases"]} == {(3, 2), (3, 5), (6, 5)}
