@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 
 from sarcover.reports.plots import subplots
+from sarcover.reports.stats import t_halfwidth
 from sarcover.reports.style import look
 
 PARTS = [("clustering_loss", "clustering loss", "tab:blue"),
@@ -91,12 +92,6 @@ def summary_table(df: pd.DataFrame) -> pd.DataFrame:
     return tab.sort_values(["skey", "order"]).drop(columns=["order", "skey"]).reset_index(drop=True)
 
 
-def _t95(n: int) -> float:
-    from scipy.stats import t
-
-    return float(t.ppf(0.975, n - 1)) if n > 1 else np.nan
-
-
 def clustering_verdicts(df: pd.DataFrame) -> pd.DataFrame:
     """ADPC's clustering loss against DPC's and KMeans', per setting and over all settings.
 
@@ -118,7 +113,7 @@ def clustering_verdicts(df: pd.DataFrame) -> pd.DataFrame:
             d = (g[a] - g[b]).to_numpy()
             n = d.size
             mean = float(d.mean()) if n else np.nan
-            half = _t95(n) * float(d.std(ddof=1)) / np.sqrt(n) if n > 1 else np.nan
+            half = t_halfwidth(d)
             lo, hi = mean - half, mean + half
             verdict = ("less" if hi < 0 else "more" if lo > 0 else "no clear difference") if n > 1 else "too few"
             rows.append({"setting": setting,

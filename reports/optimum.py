@@ -28,6 +28,7 @@ import pandas as pd
 
 from sarcover.reports.gaps import add_gaps, instance_table
 from sarcover.reports.plots import save_figure, subplots
+from sarcover.reports.stats import t_halfwidth
 from sarcover.reports.style import PAPER, PEERS, dodge, legend_outside, look
 
 SUITE = "paper-opt"
@@ -190,17 +191,12 @@ def method_gaps(df: pd.DataFrame, br: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=GAP_COLUMNS)
 
 
-def _ci(x: pd.Series) -> float:
-    x = x.dropna()
-    return 1.96 * x.std(ddof=1) / np.sqrt(len(x)) if len(x) > 1 else np.nan
-
-
 def coverage_table(df: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
-    """Per method and x of the figure: mean coverage (no plan = 0), its 95 % CI, runs."""
+    """Per method and x of the figure: mean coverage (no plan = 0), its 95 % t interval, runs."""
     s = df[(df[sweep.fixed] == sweep.value) & df[sweep.x].isin(sweep.xs)]
     cov0 = s["coverage"].astype(float).fillna(0.0)
     grp = cov0.groupby([s["method"], s[sweep.x]])
-    return pd.DataFrame({"mean": grp.mean(), "ci95": grp.apply(_ci), "runs": grp.size()}).reset_index()
+    return pd.DataFrame({"mean": grp.mean(), "ci95": grp.apply(t_halfwidth), "runs": grp.size()}).reset_index()
 
 
 def optimum_curve(br: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
