@@ -154,7 +154,7 @@ def top_rows() -> list[dict]:
         ("p4.2.b", "optimal", 190.0, 190.0, 195.0, None),      # wrong "optimal": a conflict
         ("p5.2.a", "time_limit", 300.0, 305.0, 310.0, None),   # bound below the optimum: a conflict
         ("p5.3.a", "time_limit", 410.0, 450.0, None, 400.0),   # plan above best known: news
-        ("p6.2.a", "optimal", 500.0, 500.0, None, 500.0),      # proof of a best-known-only file: news
+        ("p6.2.a", "optimal", 500.0, 500.0, None, 500.0),      # proof of a best-known-only value: not news
         ("p7.2.a", "time_limit", 90.0, 100.0, 95.0, None),     # open: certified gap 10 %
     ]
     rows = []
@@ -165,21 +165,28 @@ def top_rows() -> list[dict]:
 
 
 def test_top_sets_flag_conflicts_and_news(tmp_path):
+    """Conflicts are flagged; a plan above a best known value is news; a proof equal to a value the
+    table lists as best known only is counted apart, as new to the table and not to the literature."""
     files = file_table(pd.DataFrame(top_rows()))
     assert files.loc["p4.2.a", "proven_equal"] and not files.loc["p4.2.b", "proven_equal"]
     assert "disagree" in files.loc["p4.2.b", "conflict"]
     assert "below published optimum" in files.loc["p5.2.a", "conflict"]
     assert files.loc["p4.2.a", "conflict"] == "" and files.loc["p7.2.a", "conflict"] == ""
-    assert "new best known 410" in files.loc["p5.3.a", "news"] and files.loc["p6.2.a", "new_proof"]
+    assert "new best known 410" in files.loc["p5.3.a", "news"] and files.loc["p6.2.a", "proof_of_best_known"]
+    assert files.loc["p6.2.a", "news"] == ""
     assert files.loc["p7.2.a", "certified_gap"] == pytest.approx(0.1)
     st = set_table(files).set_index("set")
     counts = ["files", "published_optima", "bp_proven", "proven_equal_published", "conflicts"]
     assert st.loc[4, counts].tolist() == [2, 2, 2, 1, 1]
     assert st.loc[5, ["best_known_only", "conflicts", "news", "unproven"]].tolist() == [1, 1, 1, 2]
-    assert st.loc[6, "new_proofs"] == 1 and st.loc[7, "certified_gap_max"] == pytest.approx(0.1)
+    assert st.loc[6, ["proofs_of_best_known", "news"]].tolist() == [1, 0]
+    assert st.loc[7, "certified_gap_max"] == pytest.approx(0.1)
     text = "\n".join(top_sets_section(pd.DataFrame(top_rows()), tmp_path))
     assert "**CONFLICTS (2 files)" in text and "**p4.2.b:" in text and "**p5.2.a:" in text
-    assert "- p5.3.a: new best known 410 (published 400)" in text and "- p6.2.a: bp proves the optimum 500" in text
+    news, proofs = text.split("News:")[1].split("Proofs new to this project's table")
+    assert "- p5.3.a: new best known 410 (published 400)" in news and "p6.2.a" not in news
+    assert "bp proves the optimum of 1 file that" in proofs and "1 of them equal that value" in proofs
+    assert "most set 4-7 instances solved to optimality" in proofs and "- set 6 (1): p6.2.a 500" in proofs
     assert "p7.2.a 10.0 %" in text and (tmp_path / "top_4_7_files.csv").exists()
     # counts print as counts, also in a set without an open file (its gap columns are NaN)
     set4 = next(line for line in text.splitlines() if line.startswith("| 4 |"))
