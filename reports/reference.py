@@ -133,26 +133,33 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
     if pg is not None and pg_long is not None:  # bp at 300 s on some of the same instances
         pg = pd.concat([pg, pg_long.assign(method=LONG_BP)], ignore_index=True)
     timing = t1 if t1 is not None else pk  # Table I from the one-worker timing suite when there
-    L: list[str] = ["# Reference report: the paper reproduced, with optimality gaps", ""]
+    # Only the sections the stored rows fill are written: a folder of TOP rows alone gets neither the
+    # paper preset nor the paper's claims.
+    sar = any(df is not None and (df["kind"] == "sar").any() for df in (pn, pk, peers, ex, pg, em, t1, opt))
+    title = ("the paper reproduced, with optimality gaps" if sar or (root / DECOMPOSITION).is_file()
+             else "exact solvers on the TOP benchmark")
+    L: list[str] = [f"# Reference report: {title}", ""]
     L += [f"Regenerate everything (runs, then this report) with `{command}`; "
           "`python -m sarcover.benchmarks.reproduce --report-only` rewrites the report from stored results. "
           "All numbers below are computed from the stored rows (CSV tables beside this file).", ""]
-    L += ["Coverage = covered viewpoints / (M·K). A run without a plan (the method cannot cover every target "
-          "within E_max) counts as coverage 0; the share of runs with a plan is in the CSVs.", ""]
+    if sar:
+        L += ["Coverage = covered viewpoints / (M·K). A run without a plan (the method cannot cover every target "
+              "within E_max) counts as coverage 0; the share of runs with a plan is in the CSVs.", ""]
     for n in notes or []:
         L += [n, ""]
 
-    L += _preset_section()
+    if sar:
+        L += _preset_section()
     # -- run log
-    L += ["## How it was run", ""]
-    L += ["| suite | jobs | wall (s) | workers | host cpus | finished |", "|---|---|---|---|---|---|"]
-    for s in suites:
-        for w in _walls(root, s):
-            if not w["jobs"]:
-                continue  # a resume that found everything stored
-            jobs = f"{w['jobs']} (stopped)" if w.get("interrupted") else w["jobs"]
-            L.append(f"| {s} | {jobs} | {w['wall_s']:.0f} | {w['workers']} | {w.get('cpu_count')} | "
-                     f"{w['finished_at']} |")
+    log = [(s, w) for s in suites for w in _walls(root, s) if w["jobs"]]  # not a resume that found all stored
+    if log or pn is not None or pk is not None:
+        L += ["## How it was run", ""]
+    if log:
+        L += ["| suite | jobs | wall (s) | workers | host cpus | finished |", "|---|---|---|---|---|---|"]
+    for s, w in log:
+        jobs = f"{w['jobs']} (stopped)" if w.get("interrupted") else w["jobs"]
+        L.append(f"| {s} | {jobs} | {w['wall_s']:.0f} | {w['workers']} | {w.get('cpu_count')} | "
+                 f"{w['finished_at']} |")
     for name, df in [("paper-n", pn), ("paper-k", pk)]:
         if df is not None:
             p = df[df["method"].isin(PAPER)]
@@ -167,7 +174,8 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
                      + "; all runs verified: "
                      f"{int((~df['valid'].astype(bool) & df['has_plan']).sum())} invalid plans, "
                      f"{int((df['status'] == 'error').sum())} errors.")
-    L.append("")
+    if L[-1]:
+        L.append("")
 
     # -- Fig 3 / Fig 4
     tabs = {}
@@ -181,7 +189,7 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
         tabs["K"] = _sweep(pk, "K", out, "coverage_vs_K", "Fig. 4: coverage against K (M=20, N=5)", pe)
         L += ["## Coverage against the views per target K (paper Fig. 4; M=20, N=5)", "",
               "![coverage vs K](coverage_vs_K.png)", "", _md(tabs["K"]), ""]
-    if peers is not None:
+    if peers is not None and tabs:
         L += [f"pyvrp and routing ran on the first {peers.groupby(['method', 'N', 'K']).size().max()} instances "
               f"of each setting only (time limits: " + ", ".join(
                   f"{m} {peers[peers['method'] == m]['time_limit'].iloc[0]:g} s"
@@ -189,8 +197,8 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
               + "); their curves are on those instances.", ""]
 
     # -- claims
-    L += ["## The paper's claims, one by one", ""]
     if pn is not None and pk is not None:
+        L += ["## The paper's claims, one by one", ""]
         both = pd.concat([pn.assign(fig="N"), pk.assign(fig="K")], ignore_index=True)
         paired = _significance(pd.concat([_paired_best(pn, "N").assign(sweep="N"),
                                           _paired_best(pk, "K").assign(sweep="K")], ignore_index=True))
@@ -406,6 +414,8 @@ def _table1(pk: pd.DataFrame, out: Path) -> pd.DataFrame | None:
 def _gaps_section(ex, pg, out: Path) -> list[str]:
     from sarcover.reports.gaps import add_gaps, instance_table, method_table
 
+    if ex is None and pg is None:
+        return []
     L = ["## Optimality gaps (what the paper could not show)", ""]
     if ex is not None:
         inst = instance_table(ex)

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import shutil
+from pathlib import Path
+
 import pytest
 
 from sarcover.benchmarks.harness import run_suite
@@ -109,3 +112,59 @@ def test_claims_count_wilcoxon_comparisons_holm_corrected():
     weak = paired.loc[(3, "kmeans-pso")]
     assert weak["p_wilcoxon"] < 0.05 < weak["p_holm"] and weak["diff"] - weak["ci95"] > 0
     assert (paired.drop([(2, "dpc-pso"), (3, "kmeans-pso")])["p_wilcoxon"] == 1.0).all()
+
+
+ROWS = Path(__file__).resolve().parents[2] / "reports" / "reference" / "rows"  # the committed raw rows
+
+
+def _empty_sections(text: str) -> list[str]:
+    """Headings with nothing under them before the next heading of the same or a higher level."""
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    empty = []
+    for i, line in enumerate(lines):
+        if line.startswith("#"):
+            level = len(line) - len(line.lstrip("#"))
+            nxt = lines[i + 1] if i + 1 < len(lines) else "#"
+            if nxt.startswith("#") and len(nxt) - len(nxt.lstrip("#")) <= level:
+                empty.append(line)
+    return empty
+
+
+def test_reference_of_top_rows_only_has_no_paper_sections(tmp_path):
+    """From the top-4-7 rows alone: the TOP section and the run log, no paper preset, claims,
+    coverage definition or gap sections, and no heading without content."""
+    shutil.copytree(ROWS / "top-4-7", tmp_path / "root" / "top-4-7")
+    text = write_reference(tmp_path / "root", tmp_path / "out", suites=SUITES).read_text()
+    assert text.startswith("# Reference report: exact solvers on the TOP benchmark")
+    assert "## bp on the larger TOP sets" in text and "## How it was run" in text
+    for absent in ("paper preset", "The paper's claims", "Optimality gaps", "Coverage = ", "Example routes"):
+        assert absent not in text
+    assert _empty_sections(text) == []
+
+
+def test_reference_of_sar_rows_only_has_no_top_sections(tmp_path):
+    """From the exact-small rows alone: the paper preset and the gaps to the proven optimum, no
+    claims (no paper-n, paper-k), no TOP sections, and no heading without content."""
+    shutil.copytree(ROWS / "exact-small", tmp_path / "root" / "exact-small")
+    text = write_reference(tmp_path / "root", tmp_path / "out", suites=SUITES).read_text()
+    assert text.startswith("# Reference report: the paper reproduced")
+    assert "## The paper preset" in text and "### exact-small: gap to the proven optimum" in text
+    for absent in ("The paper's claims", "TOP benchmark", "TOP sets", "Paper scale"):
+        assert absent not in text
+    assert _empty_sections(text) == []
+
+
+@pytest.mark.parametrize("step, present, absent", [
+    ("top-4-7", ["## Per method", "## Time to optimality against size"], ["Coverage against", "Runtime per setting"]),
+    ("exact-small", ["## Coverage against K", "## Runtime per setting"], ["NEW BEST KNOWN"]),
+])
+def test_gap_report_writes_the_sections_its_rows_fill(tmp_path, step, present, absent):
+    """sarcover report on TOP rows only has no SAR coverage or runtime sections, on SAR rows only
+    it has them; neither has a heading without content."""
+    from sarcover.reports.report import write_report
+
+    shutil.copytree(ROWS / step, tmp_path / "res")
+    write_report(tmp_path / "res", tmp_path / "out")
+    text = (tmp_path / "out" / "report.md").read_text()
+    assert all(p in text for p in present) and not any(a in text for a in absent)
+    assert _empty_sections(text) == []
