@@ -10,7 +10,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial.distance import cdist
 
 from sarcover.formulations.errors import InstanceError
 from sarcover.formulations.geometry import viewpoints
@@ -207,6 +206,8 @@ class TOPInstance:
     def distance_matrix(self) -> np.ndarray:
         """(V+2, V+2) Euclidean distances in solver order (see :meth:`depot_coords`); read-only."""
         def make():  # cdist: the result alone, without the (V+2, V+2, 2) temporaries of broadcasting
+            from scipy.spatial.distance import cdist  # here, so that `import sarcover` does not load scipy.spatial
+
             return cdist(self.depot_coords(), self.depot_coords())
 
         return self._cached("distance", make)
