@@ -61,6 +61,7 @@ def test_published_rows_match_the_shipped_optimum():
 
 
 def test_every_row_is_unique_and_well_formed():
+    """One row per spec; an optimal row has a value, an infeasible one none; each source has a time."""
     specs = [r["spec"] for r in ROWS]
     assert len(specs) == len(set(specs))
     for r in ROWS:
@@ -92,6 +93,7 @@ def test_confirm_refuses_what_the_sources_do_not_agree_on(monkeypatch, capsys):
 
 
 def test_add_replaces_rows_of_the_same_spec(tmp_path, monkeypatch):
+    """--add keeps one row per spec: the new confirmation replaces the old."""
     path = tmp_path / "t.csv"
     regression.write_table(ROWS[:3], path)
     spec = ROWS[0]["spec"]
@@ -104,8 +106,7 @@ def test_add_replaces_rows_of_the_same_spec(tmp_path, monkeypatch):
 
 
 def test_cli_default_output_is_under_the_current_directory_not_the_package(tmp_path, monkeypatch, capsys):
-    """Without --out the command writes results/regression/optimal_values.csv under the current
-    directory, from the shipped table plus the new row, and leaves the shipped table alone."""
+    """Without --out the shipped table plus the new row go to ./results/regression/, the package's table untouched."""
     shipped = TABLE.read_bytes()
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(regression, "confirm", lambda s, t, by: {
@@ -120,6 +121,7 @@ def test_cli_default_output_is_under_the_current_directory_not_the_package(tmp_p
 
 
 def test_cli_bad_spec_is_one_line(capsys):
+    """A bad spec is one line on stderr and exit code 2."""
     assert regression.main(["--add", "nonsense:1", "--out", "/dev/null"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "nonsense:1" in err[0]

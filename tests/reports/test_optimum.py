@@ -165,8 +165,7 @@ def top_rows() -> list[dict]:
 
 
 def test_top_sets_flag_conflicts_and_news(tmp_path):
-    """Conflicts are flagged; a plan above a best known value is news; a proof equal to a value the
-    table lists as best known only is counted apart, as new to the table and not to the literature."""
+    """Conflicts are flagged, a plan above a best known value is news, a proof of a best-known-only value apart."""
     files = file_table(pd.DataFrame(top_rows()))
     assert files.loc["p4.2.a", "proven_equal"] and not files.loc["p4.2.b", "proven_equal"]
     assert "disagree" in files.loc["p4.2.b", "conflict"]
@@ -195,6 +194,7 @@ def test_top_sets_flag_conflicts_and_news(tmp_path):
 
 
 def test_top_sets_in_the_reference_report(tmp_path):
+    """The reference report gets the TOP 4-7 section and its CSVs from top-4-7 rows."""
     root = tmp_path / "root"
     write_rows(root / "top-4-7", top_rows())
     text = write_reference(root, tmp_path / "out", suites=SUITES).read_text()
@@ -203,6 +203,7 @@ def test_top_sets_in_the_reference_report(tmp_path):
 
 
 def test_decomposition_section_appears_when_its_rows_exist(tmp_path, monkeypatch, synthetic_rows):
+    """The decomposition section, its figure and CSVs appear once its rows exist, the methods in their looks."""
     from sarcover.reports.style import look
 
     ticks = {}

@@ -25,8 +25,7 @@ print(before, after_plot, matplotlib.get_backend(), type(ax.figure.canvas).__mod
 
 
 def test_plot_plan_and_write_report_keep_the_callers_backend(tmp_path):
-    """In a process whose backend is 'template', plot_plan draws in it and write_report writes its
-    PNGs, and matplotlib.get_backend() still says 'template' after both."""
+    """On the 'template' backend, plot_plan draws in it, write_report writes PNGs, and the backend stays 'template'."""
     source = {"type": "generate", "M": 4, "K": 2, "N": 2, "instance_seed": 0, "preset": "paper", "overrides": {},
               "exact": False}
     job = {"key": "sar-m4-k2-n2-s0|greedy|0", "instance": "sar-m4-k2-n2-s0", "method": "greedy", "seed": 0,

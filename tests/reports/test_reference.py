@@ -87,9 +87,8 @@ def test_long_bp_rows_join_the_paper_scale_gaps(tmp_path):
 
 
 def test_claims_count_wilcoxon_comparisons_holm_corrected():
-    """Of 8 paired comparisons, an advantage on every instance is significant; one on 6 of 30
-    instances (tied, p < 0.05 alone, its t interval above 0) is not once Holm corrects for the 8;
-    no difference never is."""
+    """Of 8 comparisons, a clear advantage is significant, a weak one (p < 0.05 alone) not after Holm, none not."""
+    # the weak one: adpc-pso ahead on 6 of 30 instances, tied on the rest; its t interval excludes 0
     import pandas as pd
 
     from sarcover.reports.reference import PAPER, _paired_best, _significance
@@ -131,8 +130,7 @@ def _empty_sections(text: str) -> list[str]:
 
 
 def test_reference_of_top_rows_only_has_no_paper_sections(tmp_path):
-    """From the top-4-7 rows alone: the TOP section and the run log, no paper preset, claims,
-    coverage definition or gap sections, and no heading without content."""
+    """From top-4-7 rows alone: the TOP section and run log, no paper section, no heading without content."""
     shutil.copytree(ROWS / "top-4-7", tmp_path / "root" / "top-4-7")
     text = write_reference(tmp_path / "root", tmp_path / "out", suites=SUITES).read_text()
     assert text.startswith("# Reference report: exact solvers on the TOP benchmark")
@@ -143,8 +141,7 @@ def test_reference_of_top_rows_only_has_no_paper_sections(tmp_path):
 
 
 def test_reference_of_sar_rows_only_has_no_top_sections(tmp_path):
-    """From the exact-small rows alone: the paper preset and the gaps to the proven optimum, no
-    claims (no paper-n, paper-k), no TOP sections, and no heading without content."""
+    """From exact-small rows alone: preset and gaps, no claims or TOP sections, no heading without content."""
     shutil.copytree(ROWS / "exact-small", tmp_path / "root" / "exact-small")
     text = write_reference(tmp_path / "root", tmp_path / "out", suites=SUITES).read_text()
     assert text.startswith("# Reference report: the paper reproduced")
@@ -159,8 +156,7 @@ def test_reference_of_sar_rows_only_has_no_top_sections(tmp_path):
     ("exact-small", ["## Coverage against K", "## Runtime per setting"], ["NEW BEST KNOWN"]),
 ])
 def test_gap_report_writes_the_sections_its_rows_fill(tmp_path, step, present, absent):
-    """sarcover report on TOP rows only has no SAR coverage or runtime sections, on SAR rows only
-    it has them; neither has a heading without content."""
+    """sarcover report has SAR coverage and runtime sections only on SAR rows, and no heading without content."""
     from sarcover.reports.report import write_report
 
     shutil.copytree(ROWS / step, tmp_path / "res")

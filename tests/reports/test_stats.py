@@ -26,8 +26,8 @@ def test_t_halfwidth_needs_two_values():
 
 
 def test_holm_by_hand():
-    """p = 0.01, 0.04, 0.03, 0.005 (m = 4): sorted 0.005·4 = 0.02, 0.01·3 = 0.03, 0.03·2 = 0.06,
-    max(0.06, 0.04·1) = 0.06; at 5 % Holm keeps two of the four, where Benjamini-Hochberg keeps all."""
+    """Holm's adjusted p-values of a four-test example worked by hand; at 5 % it keeps two, where BH keeps all."""
+    # sorted: 0.005·4 = 0.02, 0.01·3 = 0.03, 0.03·2 = 0.06, max(0.06, 0.04·1) = 0.06
     p = [0.01, 0.04, 0.03, 0.005]
     np.testing.assert_allclose(holm(p), [0.03, 0.06, 0.06, 0.02])
     assert (holm(p) <= 0.05).sum() == 2
@@ -40,8 +40,7 @@ def test_holm_leaves_nan_out_of_the_family_and_caps_at_one():
 
 
 def test_wilcoxon_p_on_ties_zeros_and_a_clear_shift():
-    """All-zero differences give p = 1; discrete, tied differences mostly one way give a small p
-    equal to scipy's signed-rank test on the non-zero ones."""
+    """All-zero differences give p = 1; tied ones mostly one way a small p, scipy's on the non-zero ones."""
     assert wilcoxon_p(np.zeros(20)) == 1.0 and np.isnan(wilcoxon_p([]))
     d = np.array([1 / 60] * 12 + [2 / 60] * 4 + [0.0] * 3 + [-1 / 60])
     assert wilcoxon_p(d) == pytest.approx(stats.wilcoxon(d[d != 0]).pvalue)

@@ -15,6 +15,7 @@ from sarcover.reports.style import GROUPS, look, ordered
 
 
 def test_every_registered_method_has_its_own_colour_and_marker_in_its_group():
+    """Every registered method has its own colour, and its own marker and one line style within its group."""
     looks = {m: look(m) for m in METHODS}
     assert len({lk.color for lk in looks.values()}) == len(METHODS)  # 11 methods, 11 colours
     assert len({(lk.color, lk.marker) for lk in looks.values()}) == len(METHODS)
@@ -86,6 +87,7 @@ def _facts(fig):
 
 
 def test_both_reports_draw_each_method_alike_with_legends_outside(results, tmp_path, monkeypatch):
+    """Every figure of both reports draws each method in its look, with legends off the data."""
     import pandas as pd
 
     figures = _figures(monkeypatch, report)
