@@ -8,7 +8,10 @@ the TOP literature publishes as proven, ``instances/top/optimal.csv``).
 ``python -m sarcover.benchmarks.regression [--time-limit S] [--random N]`` re-solves the small
 instances of the table with milp and cpsat and rewrites its ``milp+cpsat`` rows, keeping the
 others; ``--add SPEC ... --by bp+published|bp+milp|bp+cpsat`` confirms further instances and adds
-them. Instances are either generated (``gen:M,K,N,seed,e_max`` with the paper preset) or TOP
+them. Either writes the whole table to ``--out`` (default ``OUT``, under the current directory:
+never into the installed package), starting from that file if it exists, else from the shipped
+table; to ship the result, copy it over ``benchmarks/regression/optimal_values.csv`` in a
+checkout. Instances are either generated (``gen:M,K,N,seed,e_max`` with the paper preset) or TOP
 benchmark files (``top:p2.2.k``). :func:`random_cases` is also the instance family of the exact
 cross-check test.
 """
@@ -30,6 +33,7 @@ from sarcover.benchmarks.catalog import TOP_DIR, published
 
 ROOT = Path(__file__).resolve().parent
 TABLE = ROOT / "regression" / "optimal_values.csv"
+OUT = Path("results") / "regression" / "optimal_values.csv"  # the command's output, relative to the current directory
 FIELDS = ["spec", "status", "value", "confirmed_by", "milp_s", "cpsat_s", "bp_s"]
 SOURCES = ("milp+cpsat", "bp+milp", "bp+cpsat", "bp+published")
 
@@ -133,22 +137,27 @@ def confirm(spec: str, time_limit: float, by: str = "milp+cpsat") -> dict | None
     return None
 
 
-def regenerate(time_limit: float = 60.0, n_random: int = 40, path: Path = TABLE) -> list[dict]:
+def _base_rows(path: Path) -> list[dict]:
+    """The rows a run starts from: ``path``'s where it exists, else the shipped table's."""
+    return read_table(path if path.exists() else TABLE)
+
+
+def regenerate(time_limit: float = 60.0, n_random: int = 40, path: Path = OUT) -> list[dict]:
     """Re-solve the small instances with milp and cpsat; write their confirmed rows beside the
-    table's rows of other sources."""
+    table's rows of other sources to ``path``."""
     specs = [f"top:{n}" for n in TOP_SPECS] + random_cases(n_random, start=500, max_targets=6, max_views=3)
     rows = [r for r in (confirm(s, time_limit) for s in specs) if r is not None]
-    kept = [r for r in read_table(path) if r["confirmed_by"] != "milp+cpsat"] if path.exists() else []
+    kept = [r for r in _base_rows(path) if r["confirmed_by"] != "milp+cpsat"]
     write_table(rows + kept, path)
     return rows
 
 
-def add(specs: list[str], by: str, time_limit: float, path: Path = TABLE) -> list[dict]:
-    """Confirm ``specs`` by ``by`` and add the confirmed rows to the table (replacing rows of the
-    same spec)."""
+def add(specs: list[str], by: str, time_limit: float, path: Path = OUT) -> list[dict]:
+    """Confirm ``specs`` by ``by`` and write the table with the confirmed rows added (replacing
+    rows of the same spec) to ``path``."""
     rows = [r for r in (confirm(s, time_limit, by) for s in specs) if r is not None]
     new = {r["spec"] for r in rows}
-    old = [r for r in read_table(path) if r["spec"] not in new] if path.exists() else []
+    old = [r for r in _base_rows(path) if r["spec"] not in new]
     write_table(old + rows, path)
     return rows
 
@@ -157,7 +166,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m sarcover.benchmarks.regression", description=__doc__.splitlines()[0])
     ap.add_argument("--time-limit", type=float, default=60.0, help="seconds per solver and instance")
     ap.add_argument("--random", type=int, default=40, help="number of generated SAR instances")
-    ap.add_argument("--out", type=Path, default=TABLE)
+    ap.add_argument("--out", type=Path, default=OUT,
+                    help=f"the table to write (default {OUT}; it starts from this file if it exists, else from the "
+                         "shipped table)")
     ap.add_argument("--add", nargs="+", metavar="SPEC", help="confirm these specs and add them to the table")
     ap.add_argument("--by", default="bp+published", choices=SOURCES, help="the two sources for --add")
     args = ap.parse_args(argv)

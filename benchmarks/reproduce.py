@@ -134,7 +134,8 @@ def main(argv: list[str] | None = None) -> int:
                   f"{summary['counts']}", file=sys.stderr)
     notes = ([f"paper-n and paper-k ran with {args.runs} random instances per setting."] if not args.report_only
              else []) + args.note
-    path = write_reference(root, args.out, suites=SUITES, command=f"python -m sarcover.benchmarks.reproduce --runs {args.runs}", notes=notes)
+    path = write_reference(root, args.out, suites=SUITES,
+                           command=f"python -m sarcover.benchmarks.reproduce --runs {args.runs}", notes=notes)
     print(f"wrote {path}", file=sys.stderr)
     return 0
 

@@ -39,8 +39,8 @@ truly feasible and CP-SAT proved it optimal, it is the true optimum (optimal for
 feasible for the original): status OPTIMAL. Only if the relaxed optimum overruns the true budget
 by that last 1e-6·B (a route tight to within S⁻¹ per arc) is the safe model solved in the
 remaining time, with the objective capped at the relaxed bound; OPTIMAL is reported only if its
-value reaches that bound, otherwise a plan without proof (termination COMPLETED) with the relaxed bound. So scaling can cost a proof
-(never correctness): a reported OPTIMAL is always the optimum of the verifier's problem.
+value reaches that bound, otherwise a plan without proof (termination COMPLETED) with the relaxed bound. So
+scaling can cost a proof (never correctness): a reported OPTIMAL is always the optimum of the verifier's problem.
 
 Prizes must be integers or decimals with at most 6 digits; they are scaled by the smallest power
 of ten that makes them integral (exact), anything else raises :class:`CpsatInputError`.

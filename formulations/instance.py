@@ -205,10 +205,10 @@ class TOPInstance:
 
     def distance_matrix(self) -> np.ndarray:
         """(V+2, V+2) Euclidean distances in solver order (see :meth:`depot_coords`); read-only."""
-        def make():
-            pts = self.depot_coords()
-            diff = pts[:, None, :] - pts[None, :, :]
-            return np.sqrt((diff**2).sum(axis=-1))
+        def make():  # cdist: the result alone, without the (V+2, V+2, 2) temporaries of broadcasting
+            from scipy.spatial.distance import cdist  # here, so that `import sarcover` does not load scipy.spatial
+
+            return cdist(self.depot_coords(), self.depot_coords())
 
         return self._cached("distance", make)
 

@@ -158,4 +158,5 @@ def floor_to_lattice(bound: float, lattice: float | None) -> float:
     return lattice * math.floor(bound / lattice + 1e-3)
 
 
-__all__ = ["ArcGraph", "budget_with_tolerance", "floor_to_lattice", "incompatibility", "incompatible_cliques", "prize_lattice", "prune_arcs"]
+__all__ = ["ArcGraph", "budget_with_tolerance", "floor_to_lattice", "incompatibility", "incompatible_cliques",
+           "prize_lattice", "prune_arcs"]

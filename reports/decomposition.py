@@ -20,14 +20,12 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from sarcover.reports.style import look  # noqa: E402
+from sarcover.reports.plots import subplots
+from sarcover.reports.stats import t_halfwidth
+from sarcover.reports.style import look
 
 PARTS = [("clustering_loss", "clustering loss", "tab:blue"),
          ("cross_cluster", "cross-cluster part (repair/refill moves)", "tab:gray"),
@@ -94,12 +92,6 @@ def summary_table(df: pd.DataFrame) -> pd.DataFrame:
     return tab.sort_values(["skey", "order"]).drop(columns=["order", "skey"]).reset_index(drop=True)
 
 
-def _t95(n: int) -> float:
-    from scipy.stats import t
-
-    return float(t.ppf(0.975, n - 1)) if n > 1 else np.nan
-
-
 def clustering_verdicts(df: pd.DataFrame) -> pd.DataFrame:
     """ADPC's clustering loss against DPC's and KMeans', per setting and over all settings.
 
@@ -121,14 +113,15 @@ def clustering_verdicts(df: pd.DataFrame) -> pd.DataFrame:
             d = (g[a] - g[b]).to_numpy()
             n = d.size
             mean = float(d.mean()) if n else np.nan
-            half = _t95(n) * float(d.std(ddof=1)) / np.sqrt(n) if n > 1 else np.nan
+            half = t_halfwidth(d)
             lo, hi = mean - half, mean + half
             verdict = ("less" if hi < 0 else "more" if lo > 0 else "no clear difference") if n > 1 else "too few"
-            rows.append({"setting": setting, "claim": "ADPC's clustering loses less than " + ("DPC's" if other == "dpc" else "KMeans'"),
-                         "other": other, "instances": n, "adpc_pct": float(g[a].mean()), "other_pct": float(g[b].mean()),
-                         "diff_pct": mean, "ci_lo": lo, "ci_hi": hi,
-                         "adpc_better": int((d < 0).sum()), "equal": int((d == 0).sum()), "adpc_worse": int((d > 0).sum()),
-                         "verdict": verdict})
+            rows.append({"setting": setting,
+                         "claim": "ADPC's clustering loses less than " + ("DPC's" if other == "dpc" else "KMeans'"),
+                         "other": other, "instances": n, "adpc_pct": float(g[a].mean()),
+                         "other_pct": float(g[b].mean()), "diff_pct": mean, "ci_lo": lo, "ci_hi": hi,
+                         "adpc_better": int((d < 0).sum()), "equal": int((d == 0).sum()),
+                         "adpc_worse": int((d > 0).sum()), "verdict": verdict})
     return pd.DataFrame(rows)
 
 
@@ -136,7 +129,7 @@ def plot_decomposition(tab: pd.DataFrame, path: Path) -> None:
     """Stacked bars per setting: mean clustering loss, cross-cluster part and routing loss (% of
     OPT) per method; a negative cross-cluster part is drawn below zero; the dot is the mean gap."""
     settings = list(dict.fromkeys(tab["setting"]))
-    fig, axes = plt.subplots(1, len(settings), figsize=(max(5.5, 3.4 * len(settings)) + 1, 4.6), squeeze=False,
+    fig, axes = subplots(1, len(settings), figsize=(max(5.5, 3.4 * len(settings)) + 1, 4.6), squeeze=False,
                              sharey=True)
     for ax, setting in zip(axes[0], settings):
         t = tab[tab["setting"] == setting]
@@ -162,7 +155,6 @@ def plot_decomposition(tab: pd.DataFrame, path: Path) -> None:
     fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=len(labels), frameon=False)
     fig.tight_layout(rect=(0, 0.07, 1, 1))
     fig.savefig(path, dpi=130)
-    plt.close(fig)
 
 
 def _fmt(v, digits=1) -> str:
@@ -194,7 +186,8 @@ def _markdown(tab: pd.DataFrame, verdicts: pd.DataFrame, df: pd.DataFrame, headi
         if open_rows:
             lines += [f"OPT is not proven on some instances ({open_rows} of the rows): there the best proven bound "
                       "stands in for it, so gaps and clustering losses are upper bounds.", ""]
-        lines += ["| method | runs | gap | clustering loss | cross-cluster | routing loss | OPT | OPT\\|C | objective | moved views | OPT\\|C s (mean/max) |",
+        lines += ["| method | runs | gap | clustering loss | cross-cluster | routing loss | OPT | OPT\\|C | objective "
+                  "| moved views | OPT\\|C s (mean/max) |",
                   "|---|---|---|---|---|---|---|---|---|---|---|"]
         for _, r in t.iterrows():
             lines.append(
@@ -219,12 +212,14 @@ def _markdown(tab: pd.DataFrame, verdicts: pd.DataFrame, df: pd.DataFrame, headi
     lines += [f"{h2} Verdict: does ADPC's clustering lose less than DPC's and KMeans'?", "",
               "Paired per instance on the clustering loss alone (the router plays no part; OPT cancels in the "
               "difference, so this holds with bounds too). Difference = ADPC − other, % of OPT, 95 % t interval.", "",
-              "| setting | claim | instances | ADPC | other | difference [95 % CI] | ADPC better/equal/worse | verdict |",
+              "| setting | claim | instances | ADPC | other | difference [95 % CI] | ADPC better/equal/worse "
+              "| verdict |",
               "|---|---|---|---|---|---|---|---|"]
     for _, v in verdicts.iterrows():
         lines.append(f"| {v['setting']} | {v['claim']} | {v['instances']} | {_fmt(v['adpc_pct'])} % "
                      f"| {_fmt(v['other_pct'])} % | {_fmt(v['diff_pct'], 2)} [{_fmt(v['ci_lo'], 2)}, "
-                     f"{_fmt(v['ci_hi'], 2)}] | {v['adpc_better']}/{v['equal']}/{v['adpc_worse']} | **{v['verdict']}** |")
+                     f"{_fmt(v['ci_hi'], 2)}] | {v['adpc_better']}/{v['equal']}/{v['adpc_worse']} "
+                     f"| **{v['verdict']}** |")
     lines.append("")
     for other in ("dpc", "kmeans"):
         allv = verdicts[(verdicts["setting"] == "all settings") & (verdicts["other"] == other)]
@@ -243,9 +238,9 @@ def _markdown(tab: pd.DataFrame, verdicts: pd.DataFrame, df: pd.DataFrame, headi
         cl, rl = paper["clustering_loss_pct"].mean(), paper["routing_loss_pct"].mean()
         cx = paper["cross_cluster_pct"].mean()
         main = "clustering" if cl > rl else "routing"
-        lines.append(f"- Over the paper's five methods, averaged over the settings, the mean clustering loss is {_fmt(cl)} % of "
-                     f"OPT, the routing loss {_fmt(rl)} % and the cross-cluster part {_fmt(cx)} %: most of the "
-                     f"gap is {main} loss.")
+        lines.append(f"- Over the paper's five methods, averaged over the settings, the mean clustering loss is "
+                     f"{_fmt(cl)} % of OPT, the routing loss {_fmt(rl)} % and the cross-cluster part {_fmt(cx)} %: "
+                     f"most of the gap is {main} loss.")
     lines += ["", "Figure: `decomposition.png`; rows: `decomposition.csv`; table: `decomposition_summary.csv`.", ""]
     return "\n".join(lines)
 

@@ -23,16 +23,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from sarcover.reports.gaps import add_gaps, instance_table  # noqa: E402
-from sarcover.reports.plots import save_figure  # noqa: E402
-from sarcover.reports.style import PAPER, PEERS, dodge, legend_outside, look  # noqa: E402
+from sarcover.reports.gaps import add_gaps, instance_table
+from sarcover.reports.plots import save_figure, subplots
+from sarcover.reports.stats import t_halfwidth
+from sarcover.reports.style import PAPER, PEERS, dodge, legend_outside, look
 
 SUITE = "paper-opt"
 PROVER = "bp"  # the exact method of the suite: its proofs and bounds make the optimum
@@ -56,8 +53,10 @@ class Sweep:
         return [(self.value, v) if self.fixed == "K" else (v, self.value) for v in self.xs]
 
 
-SWEEPS = (Sweep("paper_opt_vs_N", "N", "K", 3, (2, 3, 4, 5, 6), "Fig. 3 with the optimum: coverage against N (M=20, K=3)"),
-          Sweep("paper_opt_vs_K", "K", "N", 5, (2, 3, 4, 5, 6), "Fig. 4 with the optimum: coverage against K (M=20, N=5)"))
+SWEEPS = (Sweep("paper_opt_vs_N", "N", "K", 3, (2, 3, 4, 5, 6),
+                "Fig. 3 with the optimum: coverage against N (M=20, K=3)"),
+          Sweep("paper_opt_vs_K", "K", "N", 5, (2, 3, 4, 5, 6),
+                "Fig. 4 with the optimum: coverage against K (M=20, N=5)"))
 
 
 def expected_settings() -> list[tuple[int, int]]:
@@ -192,17 +191,12 @@ def method_gaps(df: pd.DataFrame, br: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=GAP_COLUMNS)
 
 
-def _ci(x: pd.Series) -> float:
-    x = x.dropna()
-    return 1.96 * x.std(ddof=1) / np.sqrt(len(x)) if len(x) > 1 else np.nan
-
-
 def coverage_table(df: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
-    """Per method and x of the figure: mean coverage (no plan = 0), its 95 % CI, runs."""
+    """Per method and x of the figure: mean coverage (no plan = 0), its 95 % t interval, runs."""
     s = df[(df[sweep.fixed] == sweep.value) & df[sweep.x].isin(sweep.xs)]
     cov0 = s["coverage"].astype(float).fillna(0.0)
     grp = cov0.groupby([s["method"], s[sweep.x]])
-    return pd.DataFrame({"mean": grp.mean(), "ci95": grp.apply(_ci), "runs": grp.size()}).reset_index()
+    return pd.DataFrame({"mean": grp.mean(), "ci95": grp.apply(t_halfwidth), "runs": grp.size()}).reset_index()
 
 
 def optimum_curve(br: pd.DataFrame, sweep: Sweep) -> pd.DataFrame:
@@ -254,7 +248,7 @@ def draw_optimum(ax, curve: pd.DataFrame, x: str, width: float = 0.45) -> list:
 
 def plot_sweep(cov: pd.DataFrame, curve: pd.DataFrame, sweep: Sweep, path) -> list[str]:
     """One figure: each method's mean coverage (95 % CI) in its look, and the mean optimum."""
-    fig, ax = plt.subplots(figsize=(8.5, 4.5))
+    fig, ax = subplots(figsize=(8.5, 4.5))
     extra = draw_optimum(ax, curve, sweep.x)
     methods = [m for m in METHODS if m in set(cov["method"])]
     methods += sorted(set(cov["method"]) - set(methods))
@@ -321,9 +315,9 @@ def _setting_rows(st: pd.DataFrame) -> list[list]:
         opt = interval(r["opt_cov_lo"], r["opt_cov_hi"])
         if 0 < r["with_optimum"] < r["instances"]:
             opt += f" ({r['with_optimum']} inst.)"
-        rows.append([r["setting"], r["instances"], r["bp_time_limit"] or "–", share, r["target"],
-                     "–" if not r["bp_runs"] else f"{r['open']}" + (f" (+{r['no_bound']} no bound)" if r["no_bound"] else ""),
-                     width,
+        unproven = ("–" if not r["bp_runs"]
+                    else f"{r['open']}" + (f" (+{r['no_bound']} no bound)" if r["no_bound"] else ""))
+        rows.append([r["setting"], r["instances"], r["bp_time_limit"] or "–", share, r["target"], unproven, width,
                      opt, r["conflicts"]])
     return rows
 

@@ -1,23 +1,45 @@
 """Plot functions. Each takes ``ax=None``, draws, and neither shows nor saves. Methods keep the
-look :mod:`sarcover.reports.style` gives them; legends sit outside the data."""
+look :mod:`sarcover.reports.style` gives them; legends sit outside the data.
+
+No module of :mod:`sarcover.reports` chooses a matplotlib backend: with ``ax=None`` a plot
+function opens a pyplot figure in the caller's backend (a notebook's inline one, say), and the
+report writers draw on :func:`subplots` figures, which no backend manages and which save to files
+anywhere, a machine without a display included. The command line chooses Agg for itself.
+"""
 
 from __future__ import annotations
 
 import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.plan import Plan
+from sarcover.reports.style import look
 
-from sarcover.formulations.instance import TOPInstance  # noqa: E402
-from sarcover.formulations.plan import Plan  # noqa: E402
-from sarcover.reports.style import look  # noqa: E402
+
+def subplots(nrows: int = 1, ncols: int = 1, *, figsize=None, **kwargs):
+    """``(fig, axes)`` as ``pyplot.subplots`` gives them, on a :class:`~matplotlib.figure.Figure`
+    outside pyplot: drawing and saving it never touches the caller's backend or open figures."""
+    fig = Figure(figsize=figsize)
+    return fig, fig.subplots(nrows, ncols, **kwargs)
 
 
 def save_figure(fig, path, dpi: int = 110) -> None:
-    """Save ``fig`` to ``path`` with the legends outside its axes in the picture, and close it."""
+    """Save ``fig`` to ``path`` with the legends outside its axes in the picture, and close it if
+    pyplot holds it (a :func:`subplots` figure is freed with its last reference)."""
     fig.savefig(path, dpi=dpi, bbox_inches="tight")
-    plt.close(fig)
+    if fig.canvas.manager is not None:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+
+
+def _new_axes(figsize):
+    """Axes of a new pyplot figure, in the caller's backend (for ``ax=None``)."""
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(figsize=figsize)[1]
 
 
 def plot_plan(instance: TOPInstance, plan: Plan | None, ax=None, title: str | None = None, legend: bool = True):
@@ -26,7 +48,7 @@ def plot_plan(instance: TOPInstance, plan: Plan | None, ax=None, title: str | No
     The legend sits to the right of the axes; ``legend=False`` leaves it to the caller (one for a
     figure of panels: :func:`plan_legend`)."""
     if ax is None:
-        _, ax = plt.subplots(figsize=(7, 7))
+        ax = _new_axes((7, 7))
     visited = set(plan.visited) if plan is not None else set()
     mask = np.array([i in visited for i in range(instance.n_nodes)], dtype=bool)
     pts = instance.coords
@@ -39,7 +61,7 @@ def plot_plan(instance: TOPInstance, plan: Plan | None, ax=None, title: str | No
     ax.scatter(*instance.start, marker="s", c="k", s=70, label="base", zorder=5)
     if not instance.same_depot:
         ax.scatter(*instance.end, marker="D", c="k", s=60, label="end depot", zorder=5)
-    colors = plt.get_cmap("tab10")
+    colors = matplotlib.colormaps["tab10"]
     what = "UAV" if instance.kind == "sar" else "vehicle"
     if plan is not None:
         for r, route in enumerate(plan.routes):
@@ -84,7 +106,7 @@ def plot_anytime(series: dict, ax=None, title: str | None = None, reference: flo
     (0) does not flatten the curves; it enters from below.
     """
     if ax is None:
-        _, ax = plt.subplots(figsize=(6.5, 4.2))
+        ax = _new_axes((6.5, 4.2))
     lows, highs, t_max, used = [], [], 0.0, {}
     for method, points in series.items():
         c = used[method] = (colors or {}).get(method, look(method).color)

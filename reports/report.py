@@ -14,18 +14,14 @@ import json
 import os
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from sarcover.formulations.records import RESULTS_FILE  # noqa: E402
-from sarcover.reports.gaps import add_gaps, instance_table, method_table  # noqa: E402
-from sarcover.reports.plots import save_figure  # noqa: E402
-from sarcover.reports.results import load_results  # noqa: E402
-from sarcover.reports.style import dodge, legend_outside, look, ordered  # noqa: E402
+from sarcover.formulations.records import RESULTS_FILE
+from sarcover.reports.gaps import add_gaps, instance_table, method_table
+from sarcover.reports.plots import save_figure, subplots
+from sarcover.reports.results import load_results
+from sarcover.reports.style import dodge, legend_outside, look, ordered
 
 _PCT = ("gap_mean", "gap_median", "gap_max", "share_optimal", "gap_ub_mean", "gap_ub_median",
         "gap_ub_max", "coverage_mean")
@@ -126,7 +122,7 @@ def _coverage_against(sar: pd.DataFrame, x: str, fixed: tuple[str, str], out: Pa
             continue
         piv = g.pivot_table(index="method", columns=x, values="coverage", aggfunc="mean")
         runs = g.groupby(x)["instance"].nunique()
-        fig, ax = plt.subplots(figsize=(7.5, 4.2))
+        fig, ax = subplots(figsize=(7.5, 4.2))
         xs = list(piv.columns)
         gap = min(np.diff(xs)) if len(xs) > 1 else 1.0
         shift = dodge(piv.index, 0.5 * gap / max(len(piv.index), 1))  # equal values side by side
@@ -204,7 +200,7 @@ def _example_routes(df: pd.DataFrame, out: Path, doc: _Doc):
     cols = min(3, len(rows))
     nrows = int(np.ceil(len(rows) / cols))
     rows = rows.set_index("method").loc[ordered(rows["method"])].reset_index()
-    fig, axes = plt.subplots(nrows, cols, figsize=(5 * cols, 5 * nrows + 0.6), squeeze=False)
+    fig, axes = subplots(nrows, cols, figsize=(5 * cols, 5 * nrows + 0.6), squeeze=False)
     for ax, (_, r) in zip(axes.flat, rows.iterrows()):
         cov = f"{100 * r['coverage']:.1f}%" if pd.notna(r["coverage"]) else "-"
         plot_plan(instance, Plan.of(r["routes"]), ax=ax, title=f"{r['method']} ({r['status']}): coverage {cov}",
@@ -226,7 +222,7 @@ def _gap_distributions(gapped: pd.DataFrame, out: Path, doc: _Doc):
         data = {m: data[m] for m in ordered(data) if len(data[m])}
         if not data:
             continue
-        fig, ax = plt.subplots(figsize=(max(6, 0.8 * len(data) + 2), 4.2))
+        fig, ax = subplots(figsize=(max(6, 0.8 * len(data) + 2), 4.2))
         box = ax.boxplot(list(data.values()), showmeans=True, patch_artist=True,
                          medianprops={"color": "k"}, flierprops={"markeredgecolor": "0.4"})
         for m, patch, mean in zip(data, box["boxes"], box["means"]):  # each method in its colour
@@ -256,7 +252,7 @@ def _time_to_optimality(gapped: pd.DataFrame, out: Path, doc: _Doc):
         return
     from matplotlib.lines import Line2D
 
-    fig, ax = plt.subplots(figsize=(7.5, 4.2))
+    fig, ax = subplots(figsize=(7.5, 4.2))
     methods = ordered(ex["method"].unique())
     sizes = sorted(ex["n_nodes"].unique())
     gap = min(np.diff(sizes)) if len(sizes) > 1 else 1.0
@@ -325,7 +321,7 @@ def _anytime(df: pd.DataFrame, inst: pd.DataFrame, out: Path, doc: _Doc):
     nrows = int(np.ceil(len(pick) / cols))
     methods = ordered({m for i in pick for m in series[i]})
     colors = {m: look(m).color for m in methods}
-    fig, axes = plt.subplots(nrows, cols, figsize=(5.2 * cols, 3.8 * nrows), squeeze=False)
+    fig, axes = subplots(nrows, cols, figsize=(5.2 * cols, 3.8 * nrows), squeeze=False)
     for ax, name in zip(axes.flat, pick):
         ref = inst["opt"].get(name, np.nan) if "opt" in inst else np.nan
         plot_anytime(series[name], ax=ax, title=name, reference=None if pd.isna(ref) else float(ref),

@@ -11,7 +11,6 @@ from sarcover.benchmarks.registry import run_method
 from sarcover.formulations.cpsat import CpsatInputError, prize_scale, solve_cpsat
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.io import read_top
-from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Status
 from sarcover.formulations.verify import verify
 from sarcover.heuristics.greedy import greedy

@@ -10,7 +10,7 @@ from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.records import SCHEMA_VERSION, read_rows, upgrade_row
 from sarcover.formulations.result import (Result, SolutionStatus, Status, Termination, split_status,
-                                          summary_status, verified_result)
+                                          verified_result)
 
 
 @pytest.fixture
@@ -91,7 +91,8 @@ def test_resume_appends_schema_2_rows_to_a_schema_1_file(tmp_path):
     from sarcover.benchmarks.suite import load_suite
 
     suite_file = tmp_path / "s.toml"
-    suite_file.write_text('name = "s"\nmethods = ["greedy"]\ntime_limit = 5\n[[instances]]\nM = 3\nK = 2\nN = 1\nruns = 2\n')
+    suite_file.write_text('name = "s"\nmethods = ["greedy"]\ntime_limit = 5\n'
+                          '[[instances]]\nM = 3\nK = 2\nN = 1\nruns = 2\n')
     suite = load_suite(str(suite_file))
     out = tmp_path / "res"
     run_suite(suite, out, workers=1, progress=False)

@@ -6,16 +6,16 @@ import json
 
 import matplotlib
 import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from sarcover.benchmarks.harness import run_one
 from sarcover.benchmarks.registry import METHODS
 from sarcover.reports import optimum, reference, report
 from sarcover.reports.style import GROUPS, look, ordered
 
-matplotlib.use("Agg")
-
 
 def test_every_registered_method_has_its_own_colour_and_marker_in_its_group():
+    """Every registered method has its own colour, and its own marker and one line style within its group."""
     looks = {m: look(m) for m in METHODS}
     assert len({lk.color for lk in looks.values()}) == len(METHODS)  # 11 methods, 11 colours
     assert len({(lk.color, lk.marker) for lk in looks.values()}) == len(METHODS)
@@ -59,7 +59,7 @@ def _figures(monkeypatch, module):
     original = module.save_figure
 
     def record(fig, path, *args, **kwargs):
-        fig.canvas.draw()
+        FigureCanvasAgg(fig).draw()  # the reports' figures belong to no backend: draw them as saved
         seen.append((str(path), fig, _facts(fig)))
         return original(fig, path, *args, **kwargs)
 
@@ -87,6 +87,7 @@ def _facts(fig):
 
 
 def test_both_reports_draw_each_method_alike_with_legends_outside(results, tmp_path, monkeypatch):
+    """Every figure of both reports draws each method in its look, with legends off the data."""
     import pandas as pd
 
     figures = _figures(monkeypatch, report)

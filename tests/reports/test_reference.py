@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import shutil
+from pathlib import Path
+
 import pytest
 
 from sarcover.benchmarks.harness import run_suite
@@ -81,3 +84,83 @@ def test_long_bp_rows_join_the_paper_scale_gaps(tmp_path):
     long = runs[runs["method"] == "bp-300s"].set_index("instance")
     best = runs.groupby("instance")["best_bound"].first()
     assert (best <= long["bound"] + 1e-9).all()  # the best bound includes the long rows' bounds
+
+
+def test_claims_count_wilcoxon_comparisons_holm_corrected():
+    """Of 8 comparisons, a clear advantage is significant, a weak one (p < 0.05 alone) not after Holm, none not."""
+    # the weak one: adpc-pso ahead on 6 of 30 instances, tied on the rest; its t interval excludes 0
+    import pandas as pd
+
+    from sarcover.reports.reference import PAPER, _paired_best, _significance
+
+    rows = []
+    for n in (2, 3):
+        for i in range(30):
+            for m in PAPER:
+                cov = 0.5
+                if m == "adpc-pso":
+                    cov += 1 / 60 if n == 2 else 0.0
+                elif m == "kmeans-pso" and n == 3:
+                    cov -= 1 / 60 if i < 6 else 0.0
+                else:
+                    cov += 1 / 60 if n == 2 and m != "dpc-pso" else 0.0
+                rows.append({"instance": f"i{n}-{i}", "method": m, "N": n, "cov0": cov})
+    paired = _significance(_paired_best(pd.DataFrame(rows), "N")).set_index(["N", "vs"])
+    assert len(paired) == 8 and paired["significant"].sum() == 1
+    assert paired.loc[(2, "dpc-pso"), "significant"] and paired.loc[(2, "dpc-pso"), "diff"] > 0
+    weak = paired.loc[(3, "kmeans-pso")]
+    assert weak["p_wilcoxon"] < 0.05 < weak["p_holm"] and weak["diff"] - weak["ci95"] > 0
+    assert (paired.drop([(2, "dpc-pso"), (3, "kmeans-pso")])["p_wilcoxon"] == 1.0).all()
+
+
+ROWS = Path(__file__).resolve().parents[2] / "reports" / "reference" / "rows"  # the committed raw rows
+
+
+def _empty_sections(text: str) -> list[str]:
+    """Headings with nothing under them before the next heading of the same or a higher level."""
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    empty = []
+    for i, line in enumerate(lines):
+        if line.startswith("#"):
+            level = len(line) - len(line.lstrip("#"))
+            nxt = lines[i + 1] if i + 1 < len(lines) else "#"
+            if nxt.startswith("#") and len(nxt) - len(nxt.lstrip("#")) <= level:
+                empty.append(line)
+    return empty
+
+
+def test_reference_of_top_rows_only_has_no_paper_sections(tmp_path):
+    """From top-4-7 rows alone: the TOP section and run log, no paper section, no heading without content."""
+    shutil.copytree(ROWS / "top-4-7", tmp_path / "root" / "top-4-7")
+    text = write_reference(tmp_path / "root", tmp_path / "out", suites=SUITES).read_text()
+    assert text.startswith("# Reference report: exact solvers on the TOP benchmark")
+    assert "## bp on the larger TOP sets" in text and "## How it was run" in text
+    for absent in ("paper preset", "The paper's claims", "Optimality gaps", "Coverage = ", "Example routes"):
+        assert absent not in text
+    assert _empty_sections(text) == []
+
+
+def test_reference_of_sar_rows_only_has_no_top_sections(tmp_path):
+    """From exact-small rows alone: preset and gaps, no claims or TOP sections, no heading without content."""
+    shutil.copytree(ROWS / "exact-small", tmp_path / "root" / "exact-small")
+    text = write_reference(tmp_path / "root", tmp_path / "out", suites=SUITES).read_text()
+    assert text.startswith("# Reference report: the paper reproduced")
+    assert "## The paper preset" in text and "### exact-small: gap to the proven optimum" in text
+    for absent in ("The paper's claims", "TOP benchmark", "TOP sets", "Paper scale"):
+        assert absent not in text
+    assert _empty_sections(text) == []
+
+
+@pytest.mark.parametrize("step, present, absent", [
+    ("top-4-7", ["## Per method", "## Time to optimality against size"], ["Coverage against", "Runtime per setting"]),
+    ("exact-small", ["## Coverage against K", "## Runtime per setting"], ["NEW BEST KNOWN"]),
+])
+def test_gap_report_writes_the_sections_its_rows_fill(tmp_path, step, present, absent):
+    """sarcover report has SAR coverage and runtime sections only on SAR rows, and no heading without content."""
+    from sarcover.reports.report import write_report
+
+    shutil.copytree(ROWS / step, tmp_path / "res")
+    write_report(tmp_path / "res", tmp_path / "out")
+    text = (tmp_path / "out" / "report.md").read_text()
+    assert all(p in text for p in present) and not any(a in text for a in absent)
+    assert _empty_sections(text) == []

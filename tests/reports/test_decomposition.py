@@ -8,28 +8,7 @@ import pandas as pd
 from sarcover.reports.decomposition import clustering_verdicts, decomposition_frame, write_decomposition
 
 
-def synthetic_rows(adpc_shift: float, n: int = 12, K: int = 3) -> list[dict]:
-    """Rows of adpc-pso, dpc-pso, kmeans-pso and oracle-pso on n instances; ADPC's OPT|C is
-    ``adpc_shift`` viewpoints above the others' (plus noise); every row's parts sum to its gap."""
-    rng = np.random.default_rng(0)
-    rows = []
-    for i in range(n):
-        opt = 50.0 + i
-        base = opt - 6 - rng.integers(0, 3)
-        for method, opt_c in (("adpc-pso", base + adpc_shift + rng.integers(0, 2)), ("dpc-pso", base),
-                              ("kmeans-pso", base), ("oracle-pso", opt)):
-            cross = -1.0 if method == "dpc-pso" else 0.0
-            opt_cp = opt_c - cross
-            obj = opt_cp - 2.0
-            rows.append({"instance": f"i{i}", "M": 20, "K": K, "N": 5, "method": method, "seed": 0, "opt": opt,
-                         "opt_proven": i != 0, "opt_c": opt_c, "opt_c_proven": True, "opt_c_s": 1.0,
-                         "opt_cp": opt_cp, "objective": obj, "gap": opt - obj, "clustering_loss": opt - opt_c,
-                         "cross_cluster": cross, "routing_loss": opt_cp - obj, "n_outside": int(cross != 0),
-                         "clustering_infeasible": False, "clusters": [[0], [1]], "routes": [[0], [1]]})
-    return rows
-
-
-def test_verdicts_follow_the_numbers():
+def test_verdicts_follow_the_numbers(synthetic_rows):
     """ADPC clusterings clearly better -> "less"; no difference -> "no clear difference"."""
     better = clustering_verdicts(decomposition_frame(synthetic_rows(3.0)))
     assert set(better["verdict"]) == {"less"} and (better["diff_pct"] < 0).all()
@@ -40,7 +19,7 @@ def test_verdicts_follow_the_numbers():
     assert set(worse["verdict"]) == {"more"}
 
 
-def test_section_files_and_sums(tmp_path):
+def test_section_files_and_sums(tmp_path, synthetic_rows):
     """The section, figure and CSVs are written; per method the mean parts add up to the mean gap;
     the unproven OPT is flagged in the text; the verdict line is there."""
     rows = synthetic_rows(3.0) + synthetic_rows(0.0, K=6)

@@ -13,11 +13,9 @@ import pytest
 
 from sarcover.benchmarks.reproduce import DECOMPOSE_SETTINGS, DECOMPOSITION, EXACT_ONLY, STEPS, SUITES
 from sarcover.reports import optimum
-from sarcover.reports.optimum import SWEEPS, brackets, method_gaps, optimum_curve, setting_table
+from sarcover.reports.optimum import SWEEPS, brackets, method_gaps, setting_table
 from sarcover.reports.reference import write_reference
 from sarcover.reports.top_sets import file_table, set_table, top_sets_section
-
-matplotlib.use("Agg")
 
 
 def row(instance, method, status, objective, bound=None, *, K=3, N=2, M=20, **extra) -> dict:
@@ -101,7 +99,8 @@ def test_band_where_unproven_line_where_proven(tmp_path, monkeypatch):
     monkeypatch.setattr(optimum, "save_figure", lambda fig, path, *a, **k: figures.append((path.name, fig)))
     text = "\n".join(optimum.optimum_section(df, tmp_path))
     [(name, fig)] = figures  # Fig. 4 has no rows (no N=5): no figure, said in the text
-    assert name == "paper_opt_vs_N.png" and "Fig. 4 with the optimum: coverage against K (M=20, N=5): no rows yet" in text
+    assert name == "paper_opt_vs_N.png"
+    assert "Fig. 4 with the optimum: coverage against K (M=20, N=5): no rows yet" in text
     ax = fig.axes[0]
     [line] = [ln for ln in ax.get_lines() if ln.get_label() == "optimum"]
     assert line.get_ydata()[0] == pytest.approx(0.5) and np.isnan(line.get_ydata()[1])
@@ -155,7 +154,7 @@ def top_rows() -> list[dict]:
         ("p4.2.b", "optimal", 190.0, 190.0, 195.0, None),      # wrong "optimal": a conflict
         ("p5.2.a", "time_limit", 300.0, 305.0, 310.0, None),   # bound below the optimum: a conflict
         ("p5.3.a", "time_limit", 410.0, 450.0, None, 400.0),   # plan above best known: news
-        ("p6.2.a", "optimal", 500.0, 500.0, None, 500.0),      # proof of a best-known-only file: news
+        ("p6.2.a", "optimal", 500.0, 500.0, None, 500.0),      # proof of a best-known-only value: not news
         ("p7.2.a", "time_limit", 90.0, 100.0, 95.0, None),     # open: certified gap 10 %
     ]
     rows = []
@@ -166,19 +165,27 @@ def top_rows() -> list[dict]:
 
 
 def test_top_sets_flag_conflicts_and_news(tmp_path):
+    """Conflicts are flagged, a plan above a best known value is news, a proof of a best-known-only value apart."""
     files = file_table(pd.DataFrame(top_rows()))
     assert files.loc["p4.2.a", "proven_equal"] and not files.loc["p4.2.b", "proven_equal"]
-    assert "disagree" in files.loc["p4.2.b", "conflict"] and "below published optimum" in files.loc["p5.2.a", "conflict"]
+    assert "disagree" in files.loc["p4.2.b", "conflict"]
+    assert "below published optimum" in files.loc["p5.2.a", "conflict"]
     assert files.loc["p4.2.a", "conflict"] == "" and files.loc["p7.2.a", "conflict"] == ""
-    assert "new best known 410" in files.loc["p5.3.a", "news"] and files.loc["p6.2.a", "new_proof"]
+    assert "new best known 410" in files.loc["p5.3.a", "news"] and files.loc["p6.2.a", "proof_of_best_known"]
+    assert files.loc["p6.2.a", "news"] == ""
     assert files.loc["p7.2.a", "certified_gap"] == pytest.approx(0.1)
     st = set_table(files).set_index("set")
-    assert st.loc[4, ["files", "published_optima", "bp_proven", "proven_equal_published", "conflicts"]].tolist() == [2, 2, 2, 1, 1]
+    counts = ["files", "published_optima", "bp_proven", "proven_equal_published", "conflicts"]
+    assert st.loc[4, counts].tolist() == [2, 2, 2, 1, 1]
     assert st.loc[5, ["best_known_only", "conflicts", "news", "unproven"]].tolist() == [1, 1, 1, 2]
-    assert st.loc[6, "new_proofs"] == 1 and st.loc[7, "certified_gap_max"] == pytest.approx(0.1)
+    assert st.loc[6, ["proofs_of_best_known", "news"]].tolist() == [1, 0]
+    assert st.loc[7, "certified_gap_max"] == pytest.approx(0.1)
     text = "\n".join(top_sets_section(pd.DataFrame(top_rows()), tmp_path))
     assert "**CONFLICTS (2 files)" in text and "**p4.2.b:" in text and "**p5.2.a:" in text
-    assert "- p5.3.a: new best known 410 (published 400)" in text and "- p6.2.a: bp proves the optimum 500" in text
+    news, proofs = text.split("News:")[1].split("Proofs new to this project's table")
+    assert "- p5.3.a: new best known 410 (published 400)" in news and "p6.2.a" not in news
+    assert "bp proves the optimum of 1 file that" in proofs and "1 of them equal that value" in proofs
+    assert "most set 4-7 instances solved to optimality" in proofs and "- set 6 (1): p6.2.a 500" in proofs
     assert "p7.2.a 10.0 %" in text and (tmp_path / "top_4_7_files.csv").exists()
     # counts print as counts, also in a set without an open file (its gap columns are NaN)
     set4 = next(line for line in text.splitlines() if line.startswith("| 4 |"))
@@ -187,6 +194,7 @@ def test_top_sets_flag_conflicts_and_news(tmp_path):
 
 
 def test_top_sets_in_the_reference_report(tmp_path):
+    """The reference report gets the TOP 4-7 section and its CSVs from top-4-7 rows."""
     root = tmp_path / "root"
     write_rows(root / "top-4-7", top_rows())
     text = write_reference(root, tmp_path / "out", suites=SUITES).read_text()
@@ -194,10 +202,8 @@ def test_top_sets_in_the_reference_report(tmp_path):
     assert (tmp_path / "out" / "top_4_7_sets.csv").stat().st_size > 0
 
 
-def test_decomposition_section_appears_when_its_rows_exist(tmp_path, monkeypatch):
-    from test_reports_decomposition import synthetic_rows
-
-    from sarcover.reports import decomposition
+def test_decomposition_section_appears_when_its_rows_exist(tmp_path, monkeypatch, synthetic_rows):
+    """The decomposition section, its figure and CSVs appear once its rows exist, the methods in their looks."""
     from sarcover.reports.style import look
 
     ticks = {}
@@ -208,7 +214,7 @@ def test_decomposition_section_appears_when_its_rows_exist(tmp_path, monkeypatch
             ticks.update({t.get_text(): matplotlib.colors.to_hex(t.get_color()) for t in ax.get_xticklabels()})
         return savefig(fig, path, *args, **kwargs)
 
-    monkeypatch.setattr(decomposition.plt.Figure, "savefig", record)
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", record)
 
     root = tmp_path / "root"
     text = write_reference(root, tmp_path / "out", suites=SUITES).read_text()
@@ -240,8 +246,10 @@ def test_reproduce_runs_paper_opt_then_decomposition_then_top_4_7(tmp_path, monk
             self.meta = {"K": k, "N": n}
 
     seen = {}
-    monkeypatch.setattr(decomposition, "cases_from_results", lambda src: [Case(k, n) for k in (2, 3, 6) for n in (2, 5)])
-    monkeypatch.setattr(decomposition, "decompose", lambda cases, out, **kw: seen.update(cases=cases, out=out) or [1, 2])
+    monkeypatch.setattr(decomposition, "cases_from_results",
+                        lambda src: [Case(k, n) for k in (2, 3, 6) for n in (2, 5)])
+    monkeypatch.setattr(decomposition, "decompose",
+                        lambda cases, out, **kw: seen.update(cases=cases, out=out) or [1, 2])
     write_rows(tmp_path / "paper-opt", [])
     assert reproduce.decompose_step(tmp_path, quiet=True) == 2
     assert {(c.meta["K"], c.meta["N"]) for c in seen["cases"]} == {(3, 2), (3, 5), (6, 5)}

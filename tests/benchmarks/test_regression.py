@@ -61,6 +61,7 @@ def test_published_rows_match_the_shipped_optimum():
 
 
 def test_every_row_is_unique_and_well_formed():
+    """One row per spec; an optimal row has a value, an infeasible one none; each source has a time."""
     specs = [r["spec"] for r in ROWS]
     assert len(specs) == len(set(specs))
     for r in ROWS:
@@ -92,6 +93,7 @@ def test_confirm_refuses_what_the_sources_do_not_agree_on(monkeypatch, capsys):
 
 
 def test_add_replaces_rows_of_the_same_spec(tmp_path, monkeypatch):
+    """--add keeps one row per spec: the new confirmation replaces the old."""
     path = tmp_path / "t.csv"
     regression.write_table(ROWS[:3], path)
     spec = ROWS[0]["spec"]
@@ -103,7 +105,23 @@ def test_add_replaces_rows_of_the_same_spec(tmp_path, monkeypatch):
     assert next(r for r in rows if r["spec"] == spec)["confirmed_by"] == "bp+milp"
 
 
+def test_cli_default_output_is_under_the_current_directory_not_the_package(tmp_path, monkeypatch, capsys):
+    """Without --out the shipped table plus the new row go to ./results/regression/, the package's table untouched."""
+    shipped = TABLE.read_bytes()
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(regression, "confirm", lambda s, t, by: {
+        "spec": s, "status": "optimal", "value": "7", "confirmed_by": by, "bp_s": "0.1"})
+    assert regression.main(["--add", "top:p2.2.a", "--by", "bp+milp"]) == 0
+    out = tmp_path / "results" / "regression" / "optimal_values.csv"
+    assert f"written to {regression.OUT}" in capsys.readouterr().out
+    rows = read_table(out)
+    assert TABLE.read_bytes() == shipped
+    assert {r["spec"] for r in rows} == {r["spec"] for r in ROWS} | {"top:p2.2.a"}
+    assert next(r for r in rows if r["spec"] == "top:p2.2.a")["value"] == "7"
+
+
 def test_cli_bad_spec_is_one_line(capsys):
+    """A bad spec is one line on stderr and exit code 2."""
     assert regression.main(["--add", "nonsense:1", "--out", "/dev/null"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "nonsense:1" in err[0]
