@@ -193,7 +193,10 @@ def literal(value) -> str:
 
 def parse_literal(text: str):
     """A value from the command line or a variant name: a TOML literal (``300``, ``0.5``,
-    ``true``, ``"a b"``, ``[1, 2]``), else the text itself as a string (``tabu``)."""
+    ``true``, ``"a b"``, ``[1, 2]``), ``none`` for None (TOML has no null), else the text itself
+    as a string (``tabu``)."""
+    if text == "none":
+        return None
     try:
         return tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:

@@ -1,0 +1,104 @@
+"""Suites: a method's parameters and grids, expanded into named variants when the suite loads."""
+
+import pytest
+
+from sarcover.benchmarks.cli import EXIT_BAD_INPUT, EXIT_OK, main
+from sarcover.benchmarks.registry import METHODS
+from sarcover.benchmarks.suite import SuiteError, load_suite
+from sarcover.formulations.records import read_rows
+
+GRID = """
+name = "grid"
+methods = ["greedy", "pyvrp"]
+time_limit = 10
+[method.pyvrp.params]
+neighbours = 10
+[method.pyvrp.grid]
+iterations = [5, 20]
+exhaustive_on_best = [true, false]
+[[instances]]
+M = 4
+K = 2
+N = 2
+"""
+
+
+def write(tmp_path, body: str, name: str = "s.toml"):
+    path = tmp_path / name
+    path.write_text(body)
+    return path
+
+
+def test_a_grid_expands_into_named_variants_with_resolved_parameters(tmp_path):
+    """Two lists of two values: four variants, named by their values, in the keys' order."""
+    suite = load_suite(str(write(tmp_path, GRID)))
+    assert suite.methods == ["greedy", "pyvrp[iterations=5,exhaustive_on_best=true]",
+                             "pyvrp[iterations=5,exhaustive_on_best=false]",
+                             "pyvrp[iterations=20,exhaustive_on_best=true]",
+                             "pyvrp[iterations=20,exhaustive_on_best=false]"]
+    params = {j.method: j.params for j in suite.jobs}
+    assert params["greedy"] == {}
+    assert params["pyvrp[iterations=20,exhaustive_on_best=false]"] == {
+        **METHODS["pyvrp"].resolve(), "iterations": 20, "exhaustive_on_best": False, "neighbours": 10}
+    assert all(j.as_dict()["params"] == j.params for j in suite.jobs)
+
+
+def test_grid_variants_run_as_methods_of_their_own_and_rows_carry_their_parameters(tmp_path, capsys):
+    """`sarcover bench` on a grid: one row per variant, each with its parameters, each run with them."""
+    out = tmp_path / "res"
+    assert main(["bench", str(write(tmp_path, GRID.replace("exhaustive_on_best = [true, false]\n", ""))),
+                 "-o", str(out), "--quiet", "--workers", "1"]) == EXIT_OK
+    rows, _ = read_rows(out)
+    by_method = {r["method"]: r for r in rows}
+    assert set(by_method) == {"greedy", "pyvrp[iterations=5]", "pyvrp[iterations=20]"}
+    for its in (5, 20):
+        row = by_method[f"pyvrp[iterations={its}]"]
+        assert row["valid"] and row["info"]["params"]["iterations"] == its
+        assert row["info"]["params"]["neighbours"] == 10
+        assert row["info"]["pass1"]["iterations"] == its  # PyVRP ran the variant's iterations
+
+
+def test_methods_option_keeps_every_variant_of_a_listed_method(tmp_path):
+    """--methods pyvrp keeps all of pyvrp's variants; a variant's own name keeps that one."""
+    path = str(write(tmp_path, GRID))
+    assert len(load_suite(path, methods=["pyvrp"]).methods) == 4
+    one = "pyvrp[iterations=5,exhaustive_on_best=true]"
+    assert load_suite(path, methods=[one]).methods == [one]
+
+
+def test_a_listed_variant_name_and_an_instance_sets_override_apply(tmp_path):
+    """methods may name a variant; [instances.method.NAME] sets the time limit of all its variants."""
+    suite = load_suite(str(write(tmp_path, """
+methods = ["adpc-pso[iterations=3]", "pyvrp"]
+[method.pyvrp.grid]
+iterations = [5, 6]
+[[instances]]
+M = 3
+K = 2
+N = 1
+[instances.method.pyvrp]
+time_limit = 7
+""")))
+    limits = {j.method: j.time_limit for j in suite.jobs}
+    assert limits == {"adpc-pso[iterations=3]": 60.0, "pyvrp[iterations=5]": 7.0, "pyvrp[iterations=6]": 7.0}
+    assert {j.params["iterations"] for j in suite.jobs if j.method.startswith("adpc")} == {3}
+
+
+@pytest.mark.parametrize("table, needle", [
+    ("[method.pyvrp.params]\niteratons = 5", "unknown parameter 'iteratons'; valid: iterations (int, 2000)"),
+    ("[method.pyvrp.params]\niterations = \"many\"", "'iterations' must be int, got \"many\""),
+    ("[method.pyvrp.grid]\niterations = 5", "must be a table of parameter = [values, ...]"),
+    ("[method.pyvrp.grid]\niterations = [5, 0]", "'iterations' must be >= 1, got 0"),
+    ("[method.pyvrp.params]\niterations = 5\n[method.pyvrp.grid]\niterations = [5]", "both in params and in grid"),
+    ("[method.greedy.params]\nx = 1", "'greedy' takes no parameters"),
+])
+def test_bad_parameters_in_a_suite_are_one_line_before_anything_runs(tmp_path, capsys, table, needle):
+    """A suite's bad parameter or grid: exit 2, one line naming it and the file, no results."""
+    body = f'methods = ["greedy", "pyvrp"]\n{table}\n[[instances]]\nM = 3\nK = 2\nN = 1\n'
+    with pytest.raises(SuiteError, match="bad.toml"):
+        load_suite(str(write(tmp_path, body, "bad.toml")))
+    capsys.readouterr()
+    assert main(["bench", str(tmp_path / "bad.toml"), "-o", str(tmp_path / "res"), "--quiet"]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and needle in err, err
+    assert not (tmp_path / "res").exists()
