@@ -2,6 +2,9 @@
 
 import dataclasses
 import json
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +16,7 @@ from sarcover.benchmarks.registry import METHODS, get_method, run_method
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.result import Status, Termination
 
+ROOT = Path(__file__).resolve().parents[2]
 SMALL = sarcover.generate(targets=10, views=2, uavs=3, seed=3)
 
 
@@ -141,3 +145,95 @@ def test_run_method_prechecks_once_and_the_solver_is_not_called(monkeypatch):
     monkeypatch.setitem(METHODS, "bp", dataclasses.replace(METHODS["bp"], run=lambda *a, **k: calls.append(1)))
     res = run_method("bp", far_group())
     assert res.status == Status.INFEASIBLE and "cannot be covered" in res.reason and calls == []
+
+
+# -- moved from tests/test_bench_harness.py ---------------------------------------------------------
+def test_ad_hoc_methods_do_not_join_the_registry(tmp_path):
+    """A suite's ``module:function`` method runs, but never shows up in the shared registry."""
+    from sarcover.benchmarks.registry import METHODS, get_method, run_method
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
+    from sarcover.formulations.result import Status
+
+    before = set(METHODS)
+    inst = to_top(generate(2, 2, 1, 0))
+    result = run_method("bench_methods:all_but_last", inst, time_limit=5.0)
+    assert result.status == Status.FEASIBLE
+    assert get_method("bench_methods:nap").name == "bench_methods:nap"
+    assert set(METHODS) == before
+
+
+WARM_CHECK = r"""
+import json, sys
+from numba.core.registry import CPUDispatcher
+import sarcover.formulations.bp.pricing as pricing
+import sarcover.heuristics.kernels as kernels
+from sarcover.benchmarks.registry import METHODS, run_method, warm_up
+from sarcover.formulations.generate import generate
+from sarcover.formulations.instance import to_top
+
+def compiled():
+    out = {}
+    for mod in (pricing, kernels):
+        for name in dir(mod):
+            f = getattr(mod, name)
+            if isinstance(f, CPUDispatcher):
+                out[f"{mod.__name__}.{name}"] = len(f.signatures)
+    return out
+
+before = compiled()
+hooks = warm_up(list(METHODS))
+warmed = compiled()
+inst = to_top(generate(6, 3, 2, seed=1))
+statuses = {m: str(run_method(m, inst, seed=0, time_limit=10).status)
+            for m in ("bp", "adpc-pso", "dpc-pso", "kmeans-pso", "adpc-ga", "adpc-aco")}
+print(json.dumps({"before": before, "hooks": hooks, "warmed": warmed, "after": compiled(),
+                  "statuses": statuses}))
+"""
+
+
+def test_warm_up_leaves_nothing_for_the_jobs_to_compile():
+    """In a fresh process, the registry's warm-up hooks compile (or load from numba's disk cache)
+    every numba function that bp and the paper's pipelines then call: running them afterwards
+    adds no compiled signature. That is what keeps JIT compilation out of a job's time."""
+    out = subprocess.run([sys.executable, "-c", WARM_CHECK], cwd=ROOT, capture_output=True,
+                         text=True, timeout=600, check=True)
+    data = json.loads(out.stdout.strip().splitlines()[-1])
+    assert sorted(data["hooks"]) == ["compile_bp", "compile_routers"]
+    assert sum(data["before"].values()) == 0  # a fresh process: nothing compiled yet
+    assert data["warmed"]["sarcover.formulations.bp.pricing._label"] > 0
+    assert data["warmed"]["sarcover.heuristics.kernels.pso_iterations"] > 0
+    assert data["after"] == data["warmed"]
+    assert set(data["statuses"].values()) <= {"optimal", "feasible"}
+
+
+def test_warm_up_runs_each_hook_once_and_skips_a_broken_one(monkeypatch):
+    """Methods that share a hook compile once per process; a hook that fails is skipped."""
+    import dataclasses
+
+    import sarcover.benchmarks.registry as registry
+
+    calls = []
+
+    def hook_a():
+        calls.append("a")
+
+    def hook_b():
+        calls.append("b")
+
+    def broken():
+        raise ImportError("no such module")
+
+    methods = dict(registry.METHODS)
+    for name in ("adpc-pso", "dpc-pso", "adpc-ga"):
+        methods[name] = dataclasses.replace(methods[name], warm_up=hook_a)
+    methods["bp"] = dataclasses.replace(methods["bp"], warm_up=hook_b)
+    monkeypatch.setattr(registry, "METHODS", methods)
+    monkeypatch.setattr(registry, "_WARMED", set())
+    assert registry.warm_up(["adpc-pso", "dpc-pso", "greedy", "bp", "tests.x:y"]) == ["hook_a", "hook_b"]
+    assert registry.warm_up(["adpc-ga", "bp"]) == []  # already done in this process
+    assert calls == ["a", "b"]
+
+    methods["bp"] = dataclasses.replace(methods["bp"], warm_up=broken)
+    monkeypatch.setattr(registry, "_WARMED", set())
+    assert registry.warm_up(["bp"]) == []  # the job itself will report the problem
