@@ -19,8 +19,8 @@ Instances
     file, or a TOP benchmark name such as ``"p2.3.g"``), :func:`to_top`, :class:`SARInstance`,
     :class:`TOPInstance`.
 Methods and results
-    :func:`list_methods`, :func:`solve` (any registered method; returns a
-    :class:`VerifiedResult`), :func:`verify`, :class:`Plan`, :class:`Termination` (why a run
+    :func:`list_methods` (built in, and plugins of the entry-point group ``sarcover.methods``),
+    :func:`solve` (any method, with its ``params``; returns a :class:`VerifiedResult`), :func:`verify`, :class:`Plan`, :class:`Termination` (why a run
     stopped), :class:`SolutionStatus` (what it found), :class:`Status` (both in one word).
 Benchmarks and reports
     :func:`run_suite` (locally or on a Dask scheduler), :func:`load_results` (a pandas
