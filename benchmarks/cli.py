@@ -335,7 +335,9 @@ def _add_bench(sub):
 
 
 def _method_list(text: str) -> list[str]:
-    names = [n.strip() for n in text.split(",")]
+    from sarcover.benchmarks.params import split_top
+
+    names = [n.strip() for n in split_top(text)]  # a variant's own commas stay inside its brackets
     if not all(names):
         raise argparse.ArgumentTypeError(f"empty method name in {text!r}")
     return names

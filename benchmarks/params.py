@@ -233,7 +233,7 @@ def split_variant(name: str) -> tuple[str, dict]:
         return name, {}
     base, _, inner = name[:-1].partition("[")
     values = {}
-    for part in _split_top(inner):
+    for part in filter(str.strip, split_top(inner)):
         key, sep, text = part.partition("=")
         if not sep or not key.strip():
             raise ParamError(f"method {name!r}: {part!r} is not KEY=VALUE")
@@ -241,8 +241,8 @@ def split_variant(name: str) -> tuple[str, dict]:
     return base, values
 
 
-def _split_top(text: str) -> list[str]:
-    """``text`` split at the commas outside quotes and brackets."""
+def split_top(text: str) -> list[str]:
+    """``text`` split at the commas outside quotes and brackets (empty parts kept)."""
     parts, depth, quote, start = [], 0, None, 0
     for i, c in enumerate(text):
         if quote:
@@ -257,4 +257,4 @@ def _split_top(text: str) -> list[str]:
             parts.append(text[start:i])
             start = i + 1
     parts.append(text[start:])
-    return [p for p in parts if p.strip()]
+    return parts

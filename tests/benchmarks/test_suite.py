@@ -66,6 +66,14 @@ def test_methods_option_keeps_every_variant_of_a_listed_method(tmp_path):
     assert load_suite(path, methods=[one]).methods == [one]
 
 
+def test_bench_methods_takes_a_variant_name_with_its_own_commas(tmp_path):
+    """`bench --methods 'pyvrp[a=..,b=..],greedy'` splits at the commas outside the brackets."""
+    out = tmp_path / "res"
+    one = "pyvrp[iterations=5,exhaustive_on_best=false]"
+    assert main(["bench", str(write(tmp_path, GRID)), "-o", str(out), "--quiet", "--methods", f"{one},greedy"]) == 0
+    assert {r["method"] for r in read_rows(out)[0]} == {one, "greedy"}
+
+
 def test_a_listed_variant_name_and_an_instance_sets_override_apply(tmp_path):
     """methods may name a variant; [instances.method.NAME] sets the time limit of all its variants."""
     suite = load_suite(str(write(tmp_path, """
