@@ -51,6 +51,7 @@ def test_unknown_parameter_is_one_line_naming_the_valid_ones(capsys):
     (["--method", "pyvrp", "--param", "iterations=0"], "'iterations' must be >= 1, got 0"),
     (["--method", "cpsat", "--param", "model=tree"], "'model' must be one of \"multi\", \"vehicle\""),
     (["--method", "bp", "--param", "group_branching=1"], "'group_branching' must be bool, got 1"),
+    (["--method", "bp", "--param", "enum_share=1.5"], "'enum_share' must be in [0, 1], got 1.5"),
     (["--method", "greedy", "--param", "iterations=3"], "'greedy' takes no parameters"),
     (["--method", "pyvrp", "--param", "iterations"], "--param takes KEY=VALUE"),
     (["--method", "pyvrp[iterations=x]"], "'iterations' must be int"),
