@@ -19,10 +19,11 @@ Instances
     file, or a TOP benchmark name such as ``"p2.3.g"``), :func:`to_top`, :class:`SARInstance`,
     :class:`TOPInstance`.
 Methods and results
-    :func:`list_methods`, :func:`solve` (any registered method; returns a
-    :class:`VerifiedResult`), :func:`verify`, :class:`Plan`, :class:`Result` (what a method of
-    one's own returns), :class:`Termination` (why a run stopped), :class:`SolutionStatus` (what it
-    found), :class:`Status` (both in one word).
+    :func:`list_methods` (built in, and plugins of the entry-point group ``sarcover.methods``),
+    :func:`solve` (any method, with its ``params``; returns a :class:`VerifiedResult`),
+    :func:`verify`, :class:`Plan`, :class:`Result` (what a method of one's own returns),
+    :class:`Termination` (why a run stopped), :class:`SolutionStatus` (what it found),
+    :class:`Status` (both in one word).
 Plans from outside
     :func:`read_plan` and :func:`write_plan` (plan files, the format of ``sarcover verify``),
     :func:`verify_plan` (violations, or objective, coverage and gap to the known optimum or
@@ -39,9 +40,11 @@ registry, suites, harness, CLI) and ``sarcover.reports`` (gap tables and plots).
 
 from __future__ import annotations
 
-from importlib.metadata import PackageNotFoundError, version as _version
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _version
 from pathlib import Path
 
+from sarcover.benchmarks.methods import DEFAULT_TIME_LIMIT
 from sarcover.benchmarks.plancheck import PlanCheck
 from sarcover.formulations.instance import SARInstance, TOPInstance, to_top
 from sarcover.formulations.plan import Plan
@@ -82,23 +85,32 @@ def read_instance(source: str | Path) -> TOPInstance:
 
 
 def list_methods() -> list:
-    """The registered methods (name, exact or not, one-line summary), in the registry's order."""
-    from sarcover.benchmarks.registry import METHODS
+    """The methods (name, exact or not, one-line summary, ``params`` dataclass, ``source``): the
+    registered ones in the registry's order, then those installed packages register through the
+    entry-point group ``sarcover.methods`` (docs/methods.md)."""
+    from sarcover.benchmarks.registry import all_methods
 
-    return list(METHODS.values())
+    return all_methods()
 
 
 def solve(instance: SARInstance | TOPInstance, method: str = "greedy", *, seed: int = 0,
-          time_limit: float | None = 60.0) -> VerifiedResult:
-    """Run a registered method (or a ``"module:function"`` of one's own) and return its result as
-    the independent verifier counts it: ``status``, ``termination``, ``solution``, ``objective``
-    (the verifier's), ``bound``, ``plan``, ``runtime_s``. Never raises for a failing method (its
-    result is an error with the reason); an unknown method name raises."""
+          time_limit: float | None = DEFAULT_TIME_LIMIT, params: dict | None = None) -> VerifiedResult:
+    """Run a method (registered, a plugin's, a variant such as ``"adpc-pso[iterations=300]"``, or
+    a ``"module:function"`` of one's own) with its parameters ``params`` (``{"iterations": 300}``;
+    ``sarcover methods NAME`` lists them) and return its result as the independent verifier
+    counts it: ``status``, ``termination``, ``solution``, ``objective`` (the verifier's),
+    ``bound``, ``plan``, ``runtime_s``; ``info["params"]`` holds the fully resolved parameters.
+    Never raises for a failing method (its result is an error with the reason); an unknown
+    method, an unknown parameter or a bad value raises, before anything runs.
+
+    The composition a name stands for (``"bp"``: greedy's plan, then branch-and-price with PyVRP
+    as its primal heuristic) is one function of :mod:`sarcover.benchmarks.methods`, called by
+    :func:`sarcover.benchmarks.registry.run_method`."""
     from sarcover.benchmarks.registry import get_method, run_method
 
-    get_method(method)  # an unknown name is the caller's mistake: raise it here
+    get_method(method).resolve(params)  # the caller's mistakes raise here
     top = to_top(instance) if isinstance(instance, SARInstance) else instance
-    return run_method(method, top, seed=seed, time_limit=time_limit)
+    return run_method(method, top, seed=seed, time_limit=time_limit, params=params)
 
 
 def read_plan(path: str | Path, instance: SARInstance | TOPInstance | None = None) -> Plan:

@@ -19,6 +19,7 @@ import sys
 import textwrap
 from pathlib import Path
 
+from sarcover.benchmarks.methods import DEFAULT_TIME_LIMIT
 from sarcover.formulations.errors import SarcoverError
 from sarcover.formulations.limits import shown
 
@@ -153,18 +154,45 @@ def _cmd_generate(args) -> int:
 
 # -- methods ------------------------------------------------------------------------------------
 def _add_methods(sub):
-    p = sub.add_parser("methods", help="list the registered methods")
+    p = sub.add_parser("methods", help="list the methods, or one method's parameters",
+                       description="Without NAME: every method (built in, or registered by an installed "
+                                   "package), exact or heuristic, and where it comes from. With NAME: that "
+                                   "method's parameters (name, type, default, meaning).")
+    p.add_argument("name", nargs="?", help="a method (or a variant such as 'adpc-pso[iterations=300]')")
     p.set_defaults(func=_cmd_methods)
 
 
 def _cmd_methods(args) -> int:
-    from sarcover.benchmarks.registry import METHODS
+    from sarcover.benchmarks.registry import all_methods, get_method
 
-    width = max(len(n) for n in METHODS)
-    for spec in METHODS.values():
+    if args.name is not None:
+        _print(_method_card(get_method(args.name)))
+        return EXIT_OK
+    specs = all_methods()
+    width = max(len(spec.name) for spec in specs)
+    for spec in specs:
         kind = "exact" if spec.exact else "heuristic"
-        _print(f"{spec.name:<{width}}  {kind:<9}  {spec.summary}")
+        where = "" if spec.source == "sarcover" else f"  [{spec.source}]"
+        _print(f"{spec.name:<{width}}  {kind:<9}  {spec.summary}{where}")
     return EXIT_OK
+
+
+def _method_card(spec) -> str:
+    """A method's summary and its parameters, one a line: name, type, default (a variant's
+    value), meaning."""
+    from sarcover.benchmarks.params import accepts_any, fields, literal, type_name
+
+    kind = "exact" if spec.exact else "heuristic"
+    lines = [f"{spec.name} ({kind}, {spec.source}): {spec.summary}"]
+    if spec.params is None:
+        lines.append("parameters: any (passed through as given)" if accepts_any(spec.run) else "parameters: none")
+        return "\n".join(lines)
+    values = spec.resolve()
+    rows = [(n, type_name(t), literal(values[n]), h) for n, t, _, h in fields(spec.params)]
+    widths = [max(len(r[i]) for r in rows) for i in range(3)]
+    lines.append("parameters (solve --param KEY=VALUE; a suite's [method.NAME.params] or [method.NAME.grid]):")
+    lines += [f"  {n:<{widths[0]}}  {t:<{widths[1]}}  {d:<{widths[2]}}  {h}" for n, t, d, h in rows]
+    return "\n".join(lines)
 
 
 # -- solve --------------------------------------------------------------------------------------
@@ -181,8 +209,12 @@ def _add_solve(sub):
         epilog=EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("file", help="instance: sarcover JSON file, TOP text file, or shipped benchmark name (p2.3.g)")
     p.add_argument("--method", default=DEFAULT_METHOD,
-                   help=f"registered method (see `sarcover methods`; default {DEFAULT_METHOD})")
-    p.add_argument("--time-limit", type=_positive_float, default=60.0, help="seconds (default 60)")
+                   help=f"method (see `sarcover methods`; default {DEFAULT_METHOD})")
+    p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
+                   help="a parameter of the method (repeatable; VALUE is a TOML literal such as 300, 0.5, "
+                        "true or \"text\"; `sarcover methods NAME` lists them)")
+    p.add_argument("--time-limit", type=_positive_float, default=DEFAULT_TIME_LIMIT,
+                   help=f"seconds (default {DEFAULT_TIME_LIMIT:g})")
     p.add_argument("--seed", type=_int_at_least(0, MAX_SEED), default=0, help="random seed (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", help="write a picture of the plan (paper's Fig. 2 style; PNG unless the name says "
@@ -204,11 +236,14 @@ def solve_exit_code(run) -> int:
 
 def _cmd_solve(args) -> int:
     from sarcover.benchmarks.catalog import instance_path
+    from sarcover.benchmarks.params import parse_assignment
     from sarcover.benchmarks.registry import check_size, get_method, run_method
     from sarcover.formulations.io import load_instance
     from sarcover.formulations.records import outcome
 
     spec = get_method(args.method)
+    params = dict(parse_assignment(text) for text in args.param)
+    params = spec.resolve(params)  # an unknown parameter or a bad value: one line, exit 2, nothing run
     plot = _plot_file(args.plot) if args.plot else None
     plan_out = _output_file(args.plan_out, "--plan-out") if args.plan_out else None
     instance = load_instance(instance_path(args.file))
@@ -217,8 +252,8 @@ def _cmd_solve(args) -> int:
         from sarcover.benchmarks.harness import warm_up_methods
 
         warm_up_methods([spec.name], sys.stderr)
-    run = run_method(spec.name, instance, seed=args.seed, time_limit=args.time_limit)
-    record = {**outcome(run, instance), "exact": spec.exact}
+    run = run_method(spec.name, instance, seed=args.seed, time_limit=args.time_limit, params=params)
+    record = {**outcome(run, instance), "exact": spec.exact, "params": params}
     if plot is not None:
         _write_plot(instance, run, record, plot)
     if plan_out is not None:
@@ -252,7 +287,6 @@ def _plot_file(text: str) -> Path:
 
 def _write_plot(instance, run, record, path):
     import matplotlib.pyplot as plt
-
     from sarcover.reports.plots import plot_plan
 
     cov = f"{100 * record['coverage']:.1f}%" if record["coverage"] is not None else "no plan"
@@ -329,7 +363,9 @@ def _add_bench(sub):
 
 
 def _method_list(text: str) -> list[str]:
-    names = [n.strip() for n in text.split(",")]
+    from sarcover.benchmarks.params import split_top
+
+    names = [n.strip() for n in split_top(text)]  # a variant's own commas stay inside its brackets
     if not all(names):
         raise argparse.ArgumentTypeError(f"empty method name in {text!r}")
     return names

@@ -128,7 +128,8 @@ def run_one(job: dict) -> dict:
         instance = cached_instance(job["source"])
         row.update(kind=instance.kind, n_nodes=instance.n_nodes, n_groups=len(instance.groups),
                    n_vehicles=instance.n_vehicles, e_max=instance.budget)
-        run = run_method(job["method"], instance, seed=job["seed"], time_limit=job["time_limit"])
+        run = run_method(job["method"], instance, seed=job["seed"], time_limit=job["time_limit"],
+                         params=job.get("params"))
         rec = outcome(run, instance)
         rec.pop("instance")
         row.update(rec)

@@ -12,6 +12,10 @@ Schema (every key but ``methods`` and ``[[instances]]`` is optional)::
 
     [method.milp]                      # per-method overrides: time_limit, seeds, grace
     time_limit = 30
+    [method.bp.params]                 # the method's parameters (`sarcover methods bp` lists them)
+    enum_share = 0.0
+    [method.adpc-pso.grid]             # lists: one variant per combination, a method of its own
+    iterations = [100, 300]            # named adpc-pso[iterations=100], adpc-pso[iterations=300]
 
     [[instances]]                      # random SAR instances: the grid M × K × N, `runs` instances each
     M = 20                             # an integer or a list of integers (same for K, N)
@@ -37,15 +41,19 @@ runs × seeds jobs per method. Files are fixed instances: only ``seeds`` repeats
 
 A method named ``"package.module:function"`` (an importable module-level function with the method
 signature) is registered for the run under that name; this is how tests add crashing or hanging
-methods. Everything is checked at load: an unknown method, a bad parameter or a missing file gives
-one :class:`SuiteError` line naming the problem.
+methods. A method may also be named as a variant (``"adpc-pso[iterations=300]"``), and a
+``[method.NAME.grid]`` makes one variant per combination of its lists (their cross product, in
+the order the keys are written), each a method of its own in rows, tables and plots; a
+``[[instances]]`` set's ``methods`` and ``[instances.method.NAME]`` name the methods as the
+suite's ``methods`` does, and apply to all their variants. Each job carries its method's fully
+resolved parameters (``Job.params``). Everything is checked at load: an unknown method, a bad
+parameter or a missing file gives one :class:`SuiteError` line naming the problem.
 """
 
 from __future__ import annotations
 
 import glob
 import hashlib
-import importlib
 import itertools
 import math
 import tomllib
@@ -53,13 +61,14 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from sarcover.benchmarks.catalog import TOP_DIR, is_benchmark_name, published
+from sarcover.benchmarks.methods import DEFAULT_TIME_LIMIT
 from sarcover.formulations.errors import SarcoverError
 
 SUITES_DIR = Path(__file__).resolve().parent / "suites"
 
 DEFAULT_MEMORY_MB = 4096
 _SUITE_KEYS = {"name", "description", "methods", "time_limit", "seeds", "grace", "memory_mb", "method", "instances"}
-_METHOD_KEYS = {"time_limit", "seeds", "grace"}
+_METHOD_KEYS = {"time_limit", "seeds", "grace", "params", "grid"}
 _GEN_KEYS = {"M", "K", "N", "runs", "seed", "preset", "methods", "label", "method"}
 _GEN_OVERRIDES = ("altitude", "pitch_deg", "e_fly", "e_image", "e_max")
 _FILE_KEYS = {"files", "methods", "label", "method"}
@@ -81,11 +90,13 @@ class Job:
     time_limit: float
     grace: float
     source: dict = field(hash=False, compare=False)
+    params: dict = field(default_factory=dict, hash=False, compare=False)  # the method's, fully resolved
 
     def as_dict(self) -> dict:
         return {
             "key": self.key, "instance": self.instance, "method": self.method, "seed": self.seed,
             "run": self.run, "time_limit": self.time_limit, "grace": self.grace, "source": self.source,
+            "params": self.params,
         }
 
 
@@ -122,8 +133,9 @@ def resolve_suite_path(name_or_path: str) -> Path:
 
 def load_suite(name_or_path: str, *, runs: int | None = None, methods: list[str] | None = None) -> Suite:
     """Read, validate and expand a suite into jobs. ``runs`` replaces every random set's ``runs``;
-    ``methods`` keeps only those of the suite's methods (job keys stay the same, so a run of a
-    subset and a later run of the whole suite with ``--resume`` share one results directory)."""
+    ``methods`` keeps only those of the suite's methods (a name as the suite lists it keeps all
+    its variants; job keys stay the same, so a run of a subset and a later run of the whole suite
+    with ``--resume`` share one results directory)."""
     path = resolve_suite_path(name_or_path)
     where = path.name
     try:
@@ -133,18 +145,20 @@ def load_suite(name_or_path: str, *, runs: int | None = None, methods: list[str]
         raise SuiteError(f"suite {where}: not valid TOML ({exc})") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise SuiteError(f"suite {where}: cannot read ({exc})") from None
-    suite = _build(data, path, text, runs)
+    suite, listed = _build(data, path, text, runs)
     if methods is not None:
-        unknown = [m for m in methods if m not in suite.methods]
+        unknown = [m for m in methods if m not in suite.methods and m not in listed]
         if unknown:
             raise SuiteError(f"suite {where}: --methods names {unknown[0]!r}, not one of the suite's methods "
                              f"({', '.join(suite.methods)})")
-        keep = [m for m in suite.methods if m in methods]
+        wanted = set(methods) | {v for m in methods for v in listed.get(m, ())}
+        keep = [m for m in suite.methods if m in wanted]
         suite = replace(suite, methods=keep, jobs=[j for j in suite.jobs if j.method in keep])
     return suite
 
 
-def _build(data: dict, path: Path, text: str, runs_override: int | None) -> Suite:
+def _build(data: dict, path: Path, text: str, runs_override: int | None) -> tuple[Suite, dict[str, list[str]]]:
+    """The suite, and the variant names of each method as the suite lists it."""
     where = f"suite {path.name}"
     _no_unknown(data, _SUITE_KEYS, where)
     name = data.get("name", path.stem)
@@ -157,7 +171,7 @@ def _build(data: dict, path: Path, text: str, runs_override: int | None) -> Suit
         raise SuiteError(f"{where}: methods lists a method twice")
     exact = {m: check_method(m, where) for m in methods}
     defaults = {
-        "time_limit": _number(data.get("time_limit", 60.0), f"{where}: time_limit"),
+        "time_limit": _number(data.get("time_limit", DEFAULT_TIME_LIMIT), f"{where}: time_limit"),
         "seeds": _integer(data.get("seeds", 1), f"{where}: seeds", 1),
         "grace": data.get("grace"),
     }
@@ -171,6 +185,11 @@ def _build(data: dict, path: Path, text: str, runs_override: int | None) -> Suit
     for m in methods:
         options[m] = dict(defaults)
     options = _method_options(per_method, options, methods, where, "method")
+    variants = {m: _variants(m, per_method.get(m, {}), where) for m in methods}
+    names = [v for m in methods for v, _ in variants[m]]
+    if len(set(names)) != len(names):
+        twice = next(n for n in names if names.count(n) > 1)
+        raise SuiteError(f"{where}: method {twice!r} is listed twice (by name or by a grid)")
     sets = data.get("instances")
     if not isinstance(sets, list) or not sets or not all(isinstance(s, dict) for s in sets):
         raise SuiteError(f"{where}: at least one [[instances]] table is needed")
@@ -195,15 +214,48 @@ def _build(data: dict, path: Path, text: str, runs_override: int | None) -> Suit
                 raise SuiteError(f"{swhere}: instance name {inst_id!r} is used for two different instances")
             for m in set_methods:
                 opt = set_options[m]
-                for s in range(opt["seeds"]):
-                    tl = opt["time_limit"]
-                    grace = opt["grace"] if opt["grace"] is not None else 5.0 + 0.2 * tl
-                    key = f"{inst_id}|{m}|{s}"
-                    jobs.setdefault(key, Job(key, inst_id, m, s, run * opt["seeds"] + s, tl, grace,
-                                             {**source, "exact": exact[m]}))
+                for variant, params in variants[m]:
+                    for s in range(opt["seeds"]):
+                        tl = opt["time_limit"]
+                        grace = opt["grace"] if opt["grace"] is not None else 5.0 + 0.2 * tl
+                        key = f"{inst_id}|{variant}|{s}"
+                        jobs.setdefault(key, Job(key, inst_id, variant, s, run * opt["seeds"] + s, tl, grace,
+                                                 {**source, "exact": exact[m]}, params))
     if runs_override is not None and all("files" in spec for spec in sets):
         raise SuiteError(f"{where}: --runs sets the random instances per setting, and this suite has only files")
-    return Suite(name, path, text, str(data.get("description", "")), methods, list(jobs.values()), memory_mb)
+    suite = Suite(name, path, text, str(data.get("description", "")), names, list(jobs.values()), memory_mb)
+    return suite, {m: [v for v, _ in variants[m]] for m in methods}
+
+
+def _variants(method: str, table: dict, where: str) -> list[tuple[str, dict]]:
+    """(name, fully resolved parameters) of each variant of ``method`` (as the suite lists it):
+    its ``[method.NAME.params]`` for all, and one variant per combination of its
+    ``[method.NAME.grid]`` lists, named by the grid's values (``adpc-pso[iterations=300]``)."""
+    from sarcover.benchmarks.params import ParamError, variant_name
+    from sarcover.benchmarks.registry import get_method
+
+    twhere = f"{where}: [method.{method}"
+    params = table.get("params", {})
+    if not isinstance(params, dict):
+        raise SuiteError(f"{twhere}.params] must be a table of parameter = value")
+    grid = table.get("grid", {})
+    if not isinstance(grid, dict) or not all(isinstance(v, list) and v for v in grid.values()):
+        raise SuiteError(f"{twhere}.grid] must be a table of parameter = [values, ...] (non-empty lists)")
+    twice = sorted(set(params) & set(grid))
+    if twice:
+        raise SuiteError(f"{twhere}]: parameter {twice[0]!r} is both in params and in grid")
+    try:
+        spec = get_method(method)
+        out = []
+        for combo in itertools.product(*grid.values()):
+            values = dict(zip(grid, combo))
+            resolved = spec.resolve({**params, **values})
+            base = spec.base or spec.name
+            name = variant_name(base, {**spec.fixed, **{k: resolved[k] for k in values}})
+            out.append((name, resolved))
+    except ParamError as exc:
+        raise SuiteError(f"{where}: {exc}") from None
+    return out
 
 
 def _method_options(tables, base: dict, methods: list[str], where: str, table: str) -> dict:
@@ -217,7 +269,9 @@ def _method_options(tables, base: dict, methods: list[str], where: str, table: s
             raise SuiteError(f"{where}: [{table}.{m}] names a method not in methods")
         if not isinstance(opts, dict):
             raise SuiteError(f"{where}: [{table}.{m}] must be a table")
-        _no_unknown(opts, _METHOD_KEYS, f"{where}: [{table}.{m}]")
+        # parameters and grids are the suite's, for all its instance sets
+        _no_unknown(opts, _METHOD_KEYS if table == "method" else _METHOD_KEYS - {"params", "grid"},
+                    f"{where}: [{table}.{m}]")
         if "time_limit" in opts:
             options[m]["time_limit"] = _number(opts["time_limit"], f"{where}: [{table}.{m}] time_limit")
         if "seeds" in opts:
@@ -228,24 +282,15 @@ def _method_options(tables, base: dict, methods: list[str], where: str, table: s
 
 
 def check_method(name: str, where: str) -> bool:
-    """Raise SuiteError unless ``name`` is a registered method or an importable module:function.
-
-    Returns whether the method is exact.
+    """Raise SuiteError unless ``name`` is a registered method, a plugin's, an importable
+    module:function, or a variant of one. Returns whether the method is exact.
     """
-    from sarcover.benchmarks.registry import METHODS
+    from sarcover.benchmarks.registry import get_method
 
-    if name in METHODS:
-        return METHODS[name].exact
-    if ":" in name:
-        module, _, func = name.partition(":")
-        try:
-            fn = getattr(importlib.import_module(module), func)
-        except (ImportError, AttributeError, ValueError):
-            raise SuiteError(f"{where}: method {name!r}: cannot import function {func!r} from {module!r}") from None
-        if not callable(fn):
-            raise SuiteError(f"{where}: method {name!r} is not callable")
-        return False
-    raise SuiteError(f"{where}: unknown method {name!r}; registered: {', '.join(METHODS)}")
+    try:
+        return get_method(name).exact
+    except SarcoverError as exc:
+        raise SuiteError(f"{where}: {exc}") from None
 
 
 def _generated_sources(spec: dict, where: str, runs_override: int | None, methods: list[str]):

@@ -61,7 +61,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pyomo.environ as pyo
 
-from sarcover.formulations.instance import TOPInstance, precheck
+from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.milp import solve_milp
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Status, Termination
@@ -180,9 +180,7 @@ def solve_clustered_milp(
         return Result(METHOD, status, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
                       reason=reason, info=info)
 
-    reason = precheck(instance)
-    if reason is not None:
-        return result(Termination.INFEASIBLE, reason=reason)
+    # no pre-check: the cluster check below finds every group out of reach, and more
     owner = cluster_of(clusters)
     reach = instance.reachable()
     for gi, group in enumerate(instance.groups):
@@ -381,9 +379,7 @@ def solve_clustered(
         return Result(METHOD, status, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
                       reason=reason, info=info)
 
-    reason = precheck(instance)
-    if reason is not None:
-        return result(Termination.INFEASIBLE, reason=reason)
+    # no pre-check: the cluster check below finds every group out of reach, and more
     dec = _Decomposition(instance, clusters, deadline, seed)
     what = "target" if instance.kind == "sar" else "group"
     for gi, where in enumerate(dec.where):

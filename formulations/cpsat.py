@@ -71,7 +71,7 @@ from ortools.sat.python import cp_model
 
 from sarcover.formulations.errors import SarcoverError
 from sarcover.formulations.history import History
-from sarcover.formulations.instance import TOPInstance, precheck
+from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
 from sarcover.formulations.scaling import integer_arcs
@@ -180,7 +180,7 @@ class _Model:
         for gi, g in enumerate(inst.groups):
             lits = [self.visit[self.t_of[i]] for i in g if i in self.t_of]
             if not lits:
-                self.m.add_bool_or([])  # unreachable group: infeasible (precheck catches it first)
+                self.m.add_bool_or([])  # unreachable group: an empty clause, proven infeasible
             else:
                 self.m.add_bool_or(lits)
         if isinstance(obj, int):  # no positive prize among the reachable nodes
@@ -409,15 +409,17 @@ def solve_cpsat(
         return Result("cpsat", termination, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
                       reason=reason, info=info)
 
-    reason = precheck(instance)
-    if reason is not None:
-        return done(Termination.INFEASIBLE, reason=reason)
+    # no pre-check here (run_method runs it once per call): a group out of reach is an empty
+    # clause, which CP-SAT proves infeasible, or no node at all is reachable (below)
     pscale = prize_scale(instance.prizes)
     iprize = np.round(instance.prizes * pscale).astype(np.int64)
     relaxed = _Data(instance, relaxed=True)
     info.update(cost_scale=relaxed.scale, prize_scale=pscale, reachable=len(relaxed.nodes),
                 arcs=len(relaxed.arcs))
-    if not relaxed.nodes:  # nothing reachable and no groups (precheck): the empty plan
+    if not relaxed.nodes:  # nothing reachable: the empty plan, unless a group needs a visit
+        if instance.groups:
+            return done(Termination.INFEASIBLE, reason="no node is reachable within the budget, and every "
+                        "group needs a visit")
         return done(Termination.OPTIMAL, plan=_pad([], instance.n_vehicles), bound=0.0)
 
     built = _Model(relaxed, iprize, model, None, flow)

@@ -68,7 +68,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import maximum_flow
 
 from sarcover.formulations.history import History
-from sarcover.formulations.instance import TOPInstance, precheck
+from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
 from sarcover.formulations.preprocess import (
@@ -438,12 +438,14 @@ def solve_milp(
         return Result(METHOD, termination, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
                       reason=reason, info=info)
 
-    reason = precheck(instance)
-    if reason is not None:
-        return done(Termination.INFEASIBLE, reason=reason)
+    # no pre-check here (run_method runs it once per call): a group out of reach leaves its cover
+    # row empty, which HiGHS proves infeasible, or no node at all is reachable (below)
     g = prune_arcs(instance) if graph is None else graph
     info.update(nodes=len(g.nodes), arcs=len(g.arcs), arcs_full=g.n_arcs_full)
-    if not g.nodes:  # nothing reachable; precheck passed, so there are no groups
+    if not g.nodes:  # nothing reachable: the empty plan, unless a group needs a visit
+        if instance.groups:
+            return done(Termination.INFEASIBLE, reason="no node is reachable within the budget, and every group "
+                        "needs a visit")
         return done(Termination.OPTIMAL, plan=Plan.of([]), bound=0.0, reason="no node is reachable within the budget")
     lattice = prize_lattice(instance.prizes[[i - 1 for i in g.nodes]])
     m = build_milp(instance, g, two_cycle=two_cycle, cliques=cliques, paths=paths)

@@ -39,12 +39,14 @@ from sarcover.heuristics.routing_pso import PSORouter
 from sarcover.heuristics.tour import ClusterBatch, two_opt
 
 
-def make_clusterer(kind: str, n_clusters: int, instance: TOPInstance, seed: int):
-    """A fresh scikit-learn-style clusterer: 'adpc', 'dpc' or 'kmeans'."""
+def make_clusterer(kind: str, n_clusters: int, instance: TOPInstance, seed: int, **options):
+    """A fresh scikit-learn-style clusterer: 'adpc', 'dpc' or 'kmeans'; ``options`` are the
+    clusterer's keyword arguments (ADPC: ``xi``, ``dc``, ``dc_percentile``; DPC: ``dc``,
+    ``dc_percentile``)."""
     if kind == "adpc":
-        return ADPC(n_clusters, base=instance.start)
+        return ADPC(n_clusters, base=instance.start, **options)
     if kind == "dpc":
-        return DPC(n_clusters)
+        return DPC(n_clusters, **options)
     if kind == "kmeans":
         from sklearn.cluster import KMeans
 
@@ -69,7 +71,8 @@ def _one_openmp_thread():
 ROUTERS: dict[str, Callable[[], object]] = {"pso": PSORouter, "ga": GARouter, "aco": ACORouter}
 
 
-def cluster_stage(instance: TOPInstance, clusterer: str, *, seed: int = 0) -> list[np.ndarray]:
+def cluster_stage(instance: TOPInstance, clusterer: str, *, seed: int = 0,
+                  clusterer_options: dict | None = None) -> list[np.ndarray]:
     """The clustering stage alone: the node ids (0..V-1) of each UAV's cluster.
 
     Returns ``instance.n_vehicles`` disjoint arrays; entry i is the cluster UAV i flies (route i
@@ -86,7 +89,7 @@ def cluster_stage(instance: TOPInstance, clusterer: str, *, seed: int = 0) -> li
     k = min(n, reach.size)
     if clusterer == "kmeans":  # KMeans cannot make more clusters than distinct points
         k = min(k, np.unique(instance.coords[reach], axis=0).shape[0])
-    model = make_clusterer(clusterer, k, instance, seed)
+    model = make_clusterer(clusterer, k, instance, seed, **(clusterer_options or {}))
     if clusterer == "kmeans":  # one thread like everything else (OpenMP spinning triples CPU time)
         with _one_openmp_thread():
             labels = model.fit(instance.coords[reach]).labels_
@@ -119,7 +122,8 @@ def _check_clusters(instance: TOPInstance, clusters) -> list[np.ndarray]:
     return clusters
 
 
-def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info, t0, c0, t1, c1) -> Result:
+def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info, t0, c0, t1, c1,
+                 router_options=None) -> Result:
     """Route each cluster (router + 2-opt), then repair; route i is cluster i's UAV.
 
     ``clusters`` are node ids; the routers and the repair work in solver indices (id + 1).
@@ -130,7 +134,7 @@ def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info
     tours = [c + 1 for c in clusters]  # solver indices
     batch = ClusterBatch.of(tours, 0, end)
     if batch.which.size:
-        best, _ = ROUTERS[router]().solve(D, batch, rng, deadline)
+        best, _ = ROUTERS[router](**(router_options or {})).solve(D, batch, rng, deadline)
         tours = batch.routes(tours, best)
     tours = [two_opt(D, t, 0, end).tolist() for t in tours]
     info["stopped_by_time"] = bool(deadline is not None and time.perf_counter() > deadline)
@@ -190,9 +194,14 @@ def cluster_then_route(
     time_limit: float | None = None,
     reinsert: bool = True,
     name: str | None = None,
+    clusterer_options: dict | None = None,
+    router_options: dict | None = None,
 ) -> Result:
     """Run the pipeline and return a Result (a plan, or none with a reason).
 
+    ``clusterer_options``, ``router_options``: keyword arguments of the clusterer
+    (:func:`make_clusterer`) and of the router's class (e.g. ``n_iterations`` of
+    :class:`~sarcover.heuristics.routing_pso.PSORouter`); None: their defaults.
     :func:`cluster_stage` then the routing stage of :func:`route_clusters`: route i of the plan
     is UAV i, which flies cluster i (``info["clusters"]``, node ids); ``info["outside_cluster"]``
     lists per route the nodes repair or refill took from outside that cluster.
@@ -209,11 +218,12 @@ def cluster_then_route(
         empty = Plan.of([[] for _ in range(instance.n_vehicles)])
         return Result(name, Termination.COMPLETED, plan=empty, runtime_s=time.perf_counter() - t0, info=info)
 
-    clusters = cluster_stage(instance, clusterer, seed=seed)
+    clusters = cluster_stage(instance, clusterer, seed=seed, clusterer_options=clusterer_options)
     info["cluster_sizes"] = [int(c.size) for c in clusters]
     info["clusters"] = [c.tolist() for c in clusters]
     t1, c1 = time.perf_counter(), time.thread_time()
-    return _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info, t0, c0, t1, c1)
+    return _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info, t0, c0, t1, c1,
+                        router_options)
 
 
 def warm_up() -> None:

@@ -147,11 +147,13 @@ def cover_groups(instance: TOPInstance, routes, refill: bool = False) -> list[li
 
 
 def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: int, time_limit: float,
-           initial: list[list[int]] | None = None, iterations: int | None = ITERATIONS):
+           initial: list[list[int]] | None = None, iterations: int | None = ITERATIONS,
+           solve_params=None):
     """One PyVRP run; returns (routes as node ids or None if PyVRP found no feasible plan, info).
 
     ``initial`` (node ids, without covers only) is PyVRP's warm start; ``iterations``: the ILS
-    iterations at most (None: the time limit alone stops it)."""
+    iterations at most (None: the time limit alone stops it); ``solve_params``: PyVRP's
+    ``SolveParams`` (None: its defaults)."""
     n_veh = instance.n_vehicles
     sc = scaled_costs(instance, RESOLUTION)
     end = instance.n_nodes + 1
@@ -205,7 +207,8 @@ def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: in
         if initial is not None and not with_covers:
             client_of = {int(v): i for i, v in enumerate(nodes)}
             start_sol = Solution(m.data(), [[client_of[v] for v in r] for r in initial if r])
-        res = m.solve(stop, seed=seed, collect_stats=False, display=False, initial_solution=start_sol)
+        extra = {} if solve_params is None else {"params": solve_params}
+        res = m.solve(stop, seed=seed, collect_stats=False, display=False, initial_solution=start_sol, **extra)
     solve_s = time.perf_counter() - t_solve
     best = res.best
     info = {"scale": sc.scale, "iterations": int(res.num_iterations), "covers": with_covers,
@@ -231,14 +234,15 @@ def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: in
 
 
 def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
-          iterations: int | None = ITERATIONS, time_cap: float | None = None) -> Result:
+          iterations: int | None = ITERATIONS, time_cap: float | None = None, solve_params=None) -> Result:
     """Prize-collecting TOP by PyVRP (seeded, iteration-limited) plus group repair.
 
     With groups, pass 1 uses cover copies; pass 2 starts from pass 1's plan without them and
     repairs coverage afterwards (see the module docstring). ``iterations``: each pass's ILS
     iterations at most (None: only the time limit, at most ``time_cap``, stops the passes).
     ``time_cap``: the most seconds it runs (None: :data:`TIME_CAP`, the registered method's cap);
-    bp's primal calls after the first lift it (:func:`primal_routes`).
+    bp's primal calls after the first lift it (:func:`primal_routes`). ``solve_params``: PyVRP's
+    ``SolveParams`` for each pass (None: PyVRP's defaults).
     """
     t0 = time.perf_counter()
     time_cap = TIME_CAP if time_cap is None else time_cap
@@ -253,7 +257,7 @@ def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60
         return Result("pyvrp", Termination.COMPLETED, plan=Plan.of([[] for _ in range(instance.n_vehicles)]),
                       runtime_s=time.perf_counter() - t0, info={**info, "stopped_by": "trivial"})
     if not instance.groups:
-        routes, run_info = _solve(instance, nodes, False, seed, cap, iterations=iterations)
+        routes, run_info = _solve(instance, nodes, False, seed, cap, iterations=iterations, solve_params=solve_params)
         info.update(run_info)
         if routes is None:
             return Result("pyvrp", Termination.COMPLETED, reason="PyVRP found no plan within the budget",
@@ -265,7 +269,8 @@ def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60
     # pass 1: cover copies, so PyVRP itself covers every group; then dedupe and refill
     reason = "PyVRP found no plan within the budget"
     best_routes = None
-    routes, run_info = _solve(instance, nodes, True, seed, PASS1_SHARE * cap, iterations=iterations)
+    routes, run_info = _solve(instance, nodes, True, seed, PASS1_SHARE * cap, iterations=iterations,
+                              solve_params=solve_params)
     info["pass1"] = run_info
     if routes is not None:
         best_routes = cover_groups(instance, routes, refill=bool(run_info["duplicates_dropped"]))
@@ -273,7 +278,7 @@ def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60
     remaining = cap - (time.perf_counter() - t0)
     if remaining > 0.05:
         routes, run_info = _solve(instance, nodes, False, seed, remaining, initial=best_routes,
-                                  iterations=iterations)
+                                  iterations=iterations, solve_params=solve_params)
         info["pass2"] = run_info
         if routes is not None:
             repaired = cover_groups(instance, routes)

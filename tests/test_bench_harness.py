@@ -1,6 +1,5 @@
 """Benchmark harness: suites end to end through the CLI, failures isolated, kill + resume, Dask."""
 
-import json
 import os
 import signal
 import subprocess
@@ -211,95 +210,11 @@ def test_existing_results_need_resume(tmp_path, capsys):
     assert "--resume" in err and len(err.splitlines()) == 1
 
 
-@pytest.mark.parametrize("body, needle", [
-    ('methods = ["greedy", "no-such-method"]\n[[instances]]\nM = 3\nK = 2\nN = 1', "unknown method 'no-such-method'"),
-    ('methods = ["greedy"]\n[[instances]]\nM = 3\nK = 0\nN = 1', "K must be >= 1"),
-    ('methods = ["greedy"]\ntime_limit = "long"\n[[instances]]\nM = 3\nK = 2\nN = 1', "time_limit must be a finite number"),
-    ('methods = ["greedy"]\n[[instances]]\nM = 3\nK = 2\nN = 1\nviews = 4', "unknown key 'views'"),
-    ('methods = ["greedy"]\n[[instances]]\nfiles = ["p9.9.z"]', "instance file 'p9.9.z' not found"),
-    ('methods = ["greedy"]\n[[instances]]\nfiles = ["missing.json"]', "instance file 'missing.json' not found"),
-    ('methods = ["greedy"]\n[method.milp]\ntime_limit = 3\n[[instances]]\nM = 3\nK = 2\nN = 1', "[method.milp]"),
-    ('methods = ["greedy"\n', "not valid TOML"),
-    ('methods = ["greedy"]\n[[instances]]\nM = 3\nK = 2\nN = 1\n[instances.method.bp]\ntime_limit = 3',
-     "[instances.method.bp] names a method not in methods"),
-    ('methods = ["greedy"]\n[[instances]]\nM = 3\nK = 2\nN = 1\n[instances.method.greedy]\ntimelimit = 3',
-     "unknown key 'timelimit'"),
-])
-def test_bad_suite_files_give_one_line_error(tmp_path, capsys, body, needle):
-    """Unknown method, bad parameter, missing file: one line naming the problem, exit 2, nothing run."""
-    suite = write_suite(tmp_path, body, "bad.toml")
-    assert main(["bench", str(suite), "-o", str(tmp_path / "res"), "--quiet"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and needle in err and "bad.toml" in err, err
-    assert not (tmp_path / "res").exists()
-
-
-def test_an_instance_set_overrides_a_methods_time_limit(tmp_path):
-    """[instances.method.NAME] sets a method's time limit for that set only, over [method.NAME]."""
-    suite = load_suite(str(write_suite(tmp_path, """
-methods = ["greedy", "bp"]
-time_limit = 10
-[method.bp]
-time_limit = 60
-[[instances]]
-M = 3
-K = 2
-N = 1
-[[instances]]
-M = 3
-K = 4
-N = 1
-[instances.method.bp]
-time_limit = 300
-""")))
-    limits = {(j.source["K"], j.method): j.time_limit for j in suite.jobs}
-    assert limits == {(2, "greedy"): 10, (2, "bp"): 60, (4, "greedy"): 10, (4, "bp"): 300}
-
-
 def test_unknown_suite_name_lists_builtins(capsys):
     """A suite that is neither built in nor a file is a one-line error listing the built-ins."""
     assert main(["bench", "no-such-suite", "--quiet"]) == 2
     err = capsys.readouterr().err
     assert "quick" in err and "paper-n" in err and len(err.strip().splitlines()) == 1
-
-
-def test_runs_define_instances_and_seeds(tmp_path):
-    """runs = new random instances per setting (--runs overrides); seeds = method seeds per instance."""
-    suite = write_suite(tmp_path, """
-methods = ["greedy"]
-seeds = 2
-[[instances]]
-M = 5
-K = 2
-N = [2, 3]
-runs = 1000
-seed = 10
-""")
-    s = load_suite(str(suite), runs=3)
-    assert len(s.jobs) == 2 * 3 * 2
-    assert {j.source["instance_seed"] for j in s.jobs} == {10, 11, 12}
-    assert {j.seed for j in s.jobs} == {0, 1}
-    assert sorted(j.run for j in s.jobs if j.source["N"] == 2) == list(range(6))
-    assert len(load_suite(str(suite)).jobs) == 2 * 1000 * 2
-
-
-def test_builtin_suites_load_with_registered_methods():
-    """Every built-in suite parses, names only registered methods, and paper-n is M=20, K=3, N=2..6."""
-    from sarcover.benchmarks.suite import builtin_suites
-
-    assert {"quick", "exact-small", "paper-n", "paper-k", "top-chao"} <= set(builtin_suites())
-    for name in builtin_suites():
-        suite = load_suite(name, runs=None if name.startswith("top-") else 2)
-        assert suite.jobs, name
-    paper_n = load_suite("paper-n", runs=2)
-    assert {(j.source["M"], j.source["K"], j.source["N"]) for j in paper_n.jobs} == {(20, 3, n) for n in range(2, 7)}
-    assert not any(j.source["exact"] for j in paper_n.jobs)
-    assert load_suite("top-chao").n_instances == 117
-    top47 = load_suite("top-4-7")
-    assert top47.n_instances == 192 and top47.methods == ["bp"]
-    refs = [(j.source["reference"], j.source["best_known"]) for j in top47.jobs]
-    assert all((r is None) != (b is None) for r, b in refs)  # each file: a proven optimum or a best known value
-    assert sum(r is not None for r, _ in refs) == 50
 
 
 def test_progress_bar_counts_and_eta():
@@ -314,21 +229,6 @@ def test_progress_bar_counts_and_eta():
         bar.update(status)
     last = stream.getvalue().strip().splitlines()[-1]
     assert "4/4" in last and "100%" in last and "ETA 0:00" in last and "1 error" in last and "1 time_limit" in last
-
-
-def test_ad_hoc_methods_do_not_join_the_registry(tmp_path):
-    """A suite's ``module:function`` method runs, but never shows up in the shared registry."""
-    from sarcover.benchmarks.registry import METHODS, get_method, run_method
-    from sarcover.formulations.generate import generate
-    from sarcover.formulations.instance import to_top
-    from sarcover.formulations.result import Status
-
-    before = set(METHODS)
-    inst = to_top(generate(2, 2, 1, 0))
-    result = run_method("bench_methods:all_but_last", inst, time_limit=5.0)
-    assert result.status == Status.FEASIBLE
-    assert get_method("bench_methods:nap").name == "bench_methods:nap"
-    assert set(METHODS) == before
 
 
 def test_methods_subset_then_rest_with_resume(tmp_path, capsys):
@@ -377,82 +277,6 @@ def test_ctrl_c_records_the_part_of_the_run_that_was_stored(tmp_path):
     # the resume stops at the same job before storing anything: no second record
     assert main(["bench", str(suite), "-o", str(out), "--workers", "1", "--quiet", "--resume"]) == 130
     assert len(_walls(tmp_path, "res")) == 1
-
-
-WARM_CHECK = r"""
-import json, sys
-from numba.core.registry import CPUDispatcher
-import sarcover.formulations.bp.pricing as pricing
-import sarcover.heuristics.kernels as kernels
-from sarcover.benchmarks.registry import METHODS, run_method, warm_up
-from sarcover.formulations.generate import generate
-from sarcover.formulations.instance import to_top
-
-def compiled():
-    out = {}
-    for mod in (pricing, kernels):
-        for name in dir(mod):
-            f = getattr(mod, name)
-            if isinstance(f, CPUDispatcher):
-                out[f"{mod.__name__}.{name}"] = len(f.signatures)
-    return out
-
-before = compiled()
-hooks = warm_up(list(METHODS))
-warmed = compiled()
-inst = to_top(generate(6, 3, 2, seed=1))
-statuses = {m: str(run_method(m, inst, seed=0, time_limit=10).status)
-            for m in ("bp", "adpc-pso", "dpc-pso", "kmeans-pso", "adpc-ga", "adpc-aco")}
-print(json.dumps({"before": before, "hooks": hooks, "warmed": warmed, "after": compiled(),
-                  "statuses": statuses}))
-"""
-
-
-def test_warm_up_leaves_nothing_for_the_jobs_to_compile():
-    """In a fresh process, the registry's warm-up hooks compile (or load from numba's disk cache)
-    every numba function that bp and the paper's pipelines then call: running them afterwards
-    adds no compiled signature. That is what keeps JIT compilation out of a job's time."""
-    out = subprocess.run([sys.executable, "-c", WARM_CHECK], cwd=ROOT, capture_output=True,
-                         text=True, timeout=600, check=True)
-    data = json.loads(out.stdout.strip().splitlines()[-1])
-    assert sorted(data["hooks"]) == ["compile_bp", "compile_routers"]
-    assert sum(data["before"].values()) == 0  # a fresh process: nothing compiled yet
-    assert data["warmed"]["sarcover.formulations.bp.pricing._label"] > 0
-    assert data["warmed"]["sarcover.heuristics.kernels.pso_iterations"] > 0
-    assert data["after"] == data["warmed"]
-    assert set(data["statuses"].values()) <= {"optimal", "feasible"}
-
-
-def test_warm_up_runs_each_hook_once_and_skips_a_broken_one(monkeypatch):
-    """Methods that share a hook compile once per process; a hook that fails is skipped."""
-    import dataclasses
-
-    import sarcover.benchmarks.registry as registry
-
-    calls = []
-
-    def hook_a():
-        calls.append("a")
-
-    def hook_b():
-        calls.append("b")
-
-    def broken():
-        raise ImportError("no such module")
-
-    methods = dict(registry.METHODS)
-    for name in ("adpc-pso", "dpc-pso", "adpc-ga"):
-        methods[name] = dataclasses.replace(methods[name], warm_up=hook_a)
-    methods["bp"] = dataclasses.replace(methods["bp"], warm_up=hook_b)
-    monkeypatch.setattr(registry, "METHODS", methods)
-    monkeypatch.setattr(registry, "_WARMED", set())
-    assert registry.warm_up(["adpc-pso", "dpc-pso", "greedy", "bp", "tests.x:y"]) == ["hook_a", "hook_b"]
-    assert registry.warm_up(["adpc-ga", "bp"]) == []  # already done in this process
-    assert calls == ["a", "b"]
-
-    methods["bp"] = dataclasses.replace(methods["bp"], warm_up=broken)
-    monkeypatch.setattr(registry, "_WARMED", set())
-    assert registry.warm_up(["bp"]) == []  # the job itself will report the problem
 
 
 def test_suite_with_jit_methods_compiles_before_the_workers_start(tmp_path):

@@ -10,7 +10,7 @@ from dataclasses import asdict
 from sarcover.formulations.bp.options import BPOptions
 from sarcover.formulations.bp.pricing import warm_up
 from sarcover.formulations.bp.tree import BranchAndPrice
-from sarcover.formulations.instance import TOPInstance, precheck
+from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
 
@@ -27,13 +27,11 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
     ``options.primal_cap_s``); its routes become columns and, if verified and better, the
     incumbent. ``options``: None means :meth:`BPOptions.for_time_limit` of ``time_limit``.
     ``seed`` is unused (no randomness; timing-based choices and the time limit can still change
-    the path taken).
+    the path taken). There is no pre-check here (``run_method`` runs it once per call): a group
+    out of reach leaves the root master infeasible, which proves the instance infeasible.
     """
     warm_up()  # JIT compilation (cached on disk after the first run) is not charged to the limit
     t0 = time.perf_counter()
-    reason = precheck(instance)
-    if reason is not None:
-        return Result("bp", Termination.INFEASIBLE, reason=reason, runtime_s=time.perf_counter() - t0)
     bp = BranchAndPrice(instance, time_limit=time_limit, warm_start=warm_start, primal=primal,
                         options=options)
     proven, bound = bp.run()

@@ -10,7 +10,7 @@ them on the user's limit with :meth:`BPOptions.for_time_limit`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 CUTS_FROM_S = 60.0  # time limits from which subset-row cuts are on by default
 OPEN_CUTS_FROM_S = 300.0  # ... and from which they are tried however far the LP is from a drop
@@ -60,9 +60,17 @@ def default_cut_gap(time_limit: float | None) -> float:
     return 1.0 if time_limit is None or float(time_limit) >= OPEN_CUTS_FROM_S else 0.5
 
 
+def _opt(default, help: str, minimum: float | None = None, maximum: float | None = None):
+    """A field of :class:`BPOptions`: its default, its one-line meaning and the bounds (inclusive)
+    a value given as the ``bp`` method's parameter is checked against."""
+    return field(default=default, metadata={"help": help, "minimum": minimum, "maximum": maximum})
+
+
 @dataclass(frozen=True)
 class BPOptions:
-    """Settings of one branch-and-price run. Shares are fractions of the time limit.
+    """Settings of one branch-and-price run, and the registered ``bp``'s parameters (each field's
+    ``metadata["help"]`` is its one-line meaning, which ``sarcover methods bp`` prints). Shares
+    are fractions of the time limit.
 
     Pricing and the ng-route relaxation:
 
@@ -144,33 +152,45 @@ class BPOptions:
       ``enum_labels`` None: by the time limit (:func:`default_enum_labels`).
     """
 
-    ng_size: int = 8
-    bidirectional: bool | None = None
-    ng_columns: bool = True
-    exact_keep: float = 0.5
-    ng_cap: int = 12
-    exact_labels: int = 2_000_000
-    grow_share: float = 0.3
-    cut_rounds: int | None = None
-    cuts_per_round: int = 16
-    cut_gap: float | None = None
-    cut_share: float = 0.35
-    primal_calls: int | None = None
-    primal_share: float = 0.1
-    primal_late_share: float = 0.5
-    primal_cap_s: float = 30.0
-    dive_share: float = 0.1
-    dive_every: int = 4
-    milp_every: int = 10
-    strong: int = 5
-    group_branching: bool = False
-    elim_share: float = 0.1
-    pool_routes: int = 2000
-    enum_share: float | None = None
-    enum_gap: float = 0.3
-    enum_primal_window: float = 0.2
-    enum_labels: int | None = None
-    enum_routes: int = 3_000_000
+    ng_size: int = _opt(8, "starting ng set of a point: itself and its ng_size - 1 cheapest neighbours", 1)
+    bidirectional: bool | None = _opt(None, "exact pricing bidirectional (true) or one-way (false); none: the"
+                                            " faster of both on the first call")
+    ng_columns: bool = _opt(True, "improving ng-routes that repeat a point also enter the master")
+    exact_keep: float = _opt(0.5, "exact pricing keeps routes within this share of the best route's gain (0: "
+                                  "prune against the best)", 0, 1)
+    ng_cap: int = _opt(12, "most points an ng set grows to", 1)
+    exact_labels: int = _opt(2_000_000, "an exact pricing call gives up beyond this many labels (about 100 "
+                                        "bytes each)", 1)
+    grow_share: float = _opt(0.3, "ng sets grow only within this share of the time limit", 0, 1)
+    cut_rounds: int | None = _opt(None, "rounds of subset-row cuts at the root (0: off); none: 6 from 60 s, "
+                                        "else 0", 0)
+    cuts_per_round: int = _opt(16, "most violated subset-row triples added per round", 1)
+    cut_gap: float | None = _opt(None, "a cut round only while the root LP is within this many prize steps of"
+                                       " a drop that matters; none: by the limit", 0)
+    cut_share: float = _opt(0.35, "cut rounds start only within this share of the time limit", 0, 1)
+    primal_calls: int | None = _opt(None, "most calls of the primal heuristic (PyVRP) at the root; none: 2, "
+                                          "or 4 from 600 s", 0)
+    primal_share: float = _opt(0.1, "time of each primal heuristic call, as a share of the time limit", 0, 1)
+    primal_late_share: float = _opt(0.5, "run the first primal call once this share of the limit is used if "
+                                         "the root is still open", 0, 1)
+    primal_cap_s: float = _opt(30.0, "at most this many seconds per primal heuristic call", 0)
+    dive_share: float = _opt(0.1, "time for a dive at the root, as a share of the time limit", 0, 1)
+    dive_every: int = _opt(4, "a dive every this many nodes", 1)
+    milp_every: int = _opt(10, "a MILP over the generated routes every this many nodes", 1)
+    strong: int = _opt(5, "branching candidates compared by strong branching (1: most fractional)", 1)
+    group_branching: bool = _opt(False, "also branch on a group's number of visits")
+    elim_share: float = _opt(0.1, "time for the labelling arc bounds (arc elimination), as a share of the "
+                                  "limit", 0, 1)
+    pool_routes: int = _opt(2000, "best elementary routes of the arc-bound labelling that join the master", 0)
+    enum_share: float | None = _opt(None, "time of one route enumeration try as a share of the limit (0: "
+                                          "enumeration off); none: 0.6 from 60 s, else 0", 0, 1)
+    enum_gap: float = _opt(0.3, "enumeration is complete (a proof) while the root bound is at most this many "
+                                "prize steps above incumbent + 1", 0)
+    enum_primal_window: float = _opt(0.2, "above enum_gap, list routes within this many prize steps of the "
+                                          "best to search for a plan (0: off)", 0)
+    enum_labels: int | None = _opt(None, "an enumeration try gives up beyond this many labels; none: 2^24 "
+                                         "from 300 s, less below", 1)
+    enum_routes: int = _opt(3_000_000, "an enumeration try gives up beyond this many routes", 1)
 
     @classmethod
     def for_time_limit(cls, time_limit: float | None) -> "BPOptions":
