@@ -212,7 +212,7 @@ def cases_from_results(results_dir: str | Path, *, exact=("bp", "milp", "cpsat")
     stored exact rows: the best proven optimum (status ``optimal``, verified) if any, else the
     smallest stored bound (``opt_proven`` False); the best verified plan of any row is the oracle's.
     Instances without an optimum or a bound are skipped."""
-    from sarcover.benchmarks.harness import build_instance
+    from sarcover.benchmarks.rows import build_instance
     from sarcover.reports.results import read_rows
 
     rows, _ = read_rows(results_dir)

@@ -263,7 +263,7 @@ def run_method(name: str, instance: TOPInstance, *, seed: int = 0, time_limit: f
     try:
         result = spec.run(instance, seed=seed, time_limit=time_limit)
     except Exception as exc:  # a method bug must not stop a benchmark
-        tb = traceback.format_exc(limit=-3).strip().splitlines()
+        tb = traceback.format_exc().strip().splitlines()
         return VerifiedResult.failed(name, Termination.ERROR, f"{type(exc).__name__}: {exc}",
                                      time.perf_counter() - t0, info={"traceback": tb})
     return verified_result(instance, result, method=name, runtime_s=time.perf_counter() - t0)

@@ -19,7 +19,8 @@ import random
 
 import pytest
 
-from sarcover.benchmarks.harness import ResultsStore, build_instance, run_one
+from sarcover.benchmarks.rows import build_instance, run_one
+from sarcover.benchmarks.store import ResultsStore
 from sarcover.reports.report import write_report
 from sarcover.reports.results import SCHEMA_VERSION
 

@@ -1,0 +1,62 @@
+"""The local worker pool (benchmarks/pool.py): deadlines, dead workers, memory cap, batches."""
+
+import time
+
+from sarcover.benchmarks.cli import main
+
+from bench_suites import rows_of, write_suite
+
+
+def test_crashing_dying_hanging_and_hogging_methods_do_not_stop_the_suite(tmp_path):
+    """Raise / dead worker / memory hog: error rows; a hang is killed as time_limit; greedy still runs."""
+    suite = write_suite(tmp_path, """
+methods = ["bench_methods:crash", "bench_methods:die", "bench_methods:hang", "bench_methods:hog", "greedy"]
+time_limit = 0.3
+grace = 0.3
+memory_mb = 1500
+[[instances]]
+M = 3
+K = 2
+N = 2
+runs = 2
+""")
+    out = tmp_path / "res"
+    t0 = time.monotonic()
+    assert main(["bench", str(suite), "-o", str(out), "--workers", "2", "--quiet"]) == 0
+    assert time.monotonic() - t0 < 20
+    by = {}
+    for r in rows_of(out):
+        by.setdefault(r["method"], []).append(r)
+    assert all(len(v) == 2 for v in by.values()) and len(by) == 5
+    assert all(r["status"] == "error" and "boom" in r["reason"] for r in by["bench_methods:crash"])
+    assert all(r["status"] == "error" and "exited with code 3" in r["reason"] for r in by["bench_methods:die"])
+    assert all(r["status"] == "time_limit" and "killed" in r["reason"] for r in by["bench_methods:hang"])
+    assert all(r["status"] == "error" and "MemoryError" in r["reason"] for r in by["bench_methods:hog"])
+    assert all(r["status"] == "feasible" and r["valid"] for r in by["greedy"])
+
+
+def test_a_groups_jobs_go_to_one_worker_task_and_long_jobs_alone():
+    """next_batch: consecutive jobs of one group form one task whatever their time limits; long
+    jobs go alone; short ungrouped jobs are batched but never with a group's."""
+    from collections import deque
+
+    from sarcover.benchmarks.pool import next_batch
+
+    def j(tl, group=None):
+        return {"time_limit": tl, "group": group}
+
+    pending = deque([j(60, "a"), j(60, "a"), j(1, "a"), j(60, "b"), j(60), j(1), j(1), j(1, "c")])
+    assert [len(next_batch(pending, 1)) for _ in range(3)] == [3, 1, 1]
+    assert next_batch(pending, 1) == [j(1)]  # a quarter of what is left: one
+    assert next_batch(pending, 1) == [j(1)] and next_batch(pending, 1) == [j(1, "c")]
+
+
+def test_a_dead_workers_output_is_kept_in_the_workers_log(tmp_path):
+    """What a worker prints (solver chatter, a crash message) goes to RESULTS/workers.log, not to
+    /dev/null, and the run's progress line stays whole."""
+    suite = write_suite(tmp_path, 'methods = ["bench_methods:chatter"]\n[[instances]]\nM = 2\nK = 2\nN = 1\n')
+    assert main(["bench", str(suite), "-o", str(tmp_path / "res"), "--quiet"]) == 0
+    [row] = rows_of(tmp_path / "res")
+    assert row["status"] == "error" and "exited with code 5" in row["reason"]
+    text = (tmp_path / "res" / "workers.log").read_text()
+    assert "chatter on stdout" in text and "last words on stderr" in text
