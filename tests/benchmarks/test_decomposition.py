@@ -176,3 +176,41 @@ def test_unproven_opt_is_flagged(tmp_path):
     assert r["clustering_loss"] + r["cross_cluster"] + r["routing_loss"] == r["gap"]
     assert np.isclose(r["clustering_loss"], case.opt + 3 - r["opt_c"])
 
+
+
+def test_a_killed_or_hung_worker_becomes_a_row_and_the_run_goes_on(tmp_path, monkeypatch):
+    """A decomposition job whose process dies (as under the OOM killer) is an error row naming
+    the signal, one that overruns its deadline is killed as a time_limit row, and the other jobs
+    still get their rows; a resume keeps them (one row per key)."""
+    import os
+    import signal
+    import time
+
+    import sarcover.benchmarks.decomposition as decomposition
+
+    inst = to_top(generate(5, 2, 2, seed=4))
+    cases = cases_from_instances([("a", inst, {}), ("b", inst, {})], opt_method="milp", time_limit=60, stream=None)
+    real = decomposition._run_paper_method
+
+    def faulty(method, instance, seed, time_limit):  # forked workers inherit it
+        if method == "dpc-pso" and seed == 0:
+            os.kill(os.getpid(), signal.SIGKILL)
+        if method == "dpc-pso" and seed == 1:
+            time.sleep(600)
+        return real(method, instance, seed, time_limit)
+
+    monkeypatch.setattr(decomposition, "_run_paper_method", faulty)
+    path = tmp_path / "rows.jsonl"
+    t0 = time.monotonic()
+    rows = decompose(cases, path, methods=("adpc-pso", "dpc-pso"), seeds=(0, 1), time_limit=1.0,
+                     clustered_time_limit=1.0, grace=1.0, workers=2, stream=None)
+    assert time.monotonic() - t0 < 60
+    by = {row_key(r): r for r in rows}
+    assert len(rows) == len(by) == 8
+    for name in ("a", "b"):
+        assert by[f"{name}|dpc-pso|0"]["status"] == "error" and "SIGKILL" in by[f"{name}|dpc-pso|0"]["reason"]
+        assert by[f"{name}|dpc-pso|1"]["status"] == "time_limit" and "killed after" in by[f"{name}|dpc-pso|1"]["reason"]
+        for s in (0, 1):
+            r = by[f"{name}|adpc-pso|{s}"]
+            assert r["clustering_loss"] + r["cross_cluster"] + r["routing_loss"] == r["gap"]
+    assert len(decompose(cases, path, methods=("adpc-pso", "dpc-pso"), seeds=(0, 1), stream=None)) == 8
