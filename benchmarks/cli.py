@@ -298,6 +298,10 @@ def _add_bench(sub):
     p.add_argument("--runs", type=_int_at_least(1), help="random instances per setting (replaces the suite's runs)")
     p.add_argument("--methods", type=_method_list, help="run only these of the suite's methods, comma-separated")
     p.add_argument("--scheduler", help="run on a Dask cluster, e.g. tcp://HOST:8786")
+    p.add_argument("--tls-ca-file", metavar="PEM", help="with --scheduler tls://...: the CA certificate that "
+                   "signed the cluster's certificates")
+    p.add_argument("--tls-cert", metavar="PEM", help="this client's certificate (may hold its key too)")
+    p.add_argument("--tls-key", metavar="PEM", help="this client's private key, if not in --tls-cert")
     p.add_argument("--strict", action="store_true", help=f"exit {EXIT_JOBS_FAILED} when any job of the suite "
                    "ended in error, in this run or a stored one (a crash, a dead worker, a rejected plan)")
     _add_verbosity(p, quiet_help="no progress bar, warnings only")
@@ -311,14 +315,35 @@ def _method_list(text: str) -> list[str]:
     return names
 
 
+def _tls(args):
+    """The Dask ``Security`` of the --tls-* flags (None without them), checked before anything runs."""
+    given = {flag: value for flag, value in (("--tls-ca-file", args.tls_ca_file), ("--tls-cert", args.tls_cert),
+                                             ("--tls-key", args.tls_key)) if value is not None}
+    if not given:
+        return None
+    if not args.scheduler:
+        raise CLIError(f"{next(iter(given))} is for a Dask cluster; give --scheduler tls://HOST:PORT too")
+    for flag in ("--tls-ca-file", "--tls-cert"):
+        if flag not in given:
+            raise CLIError(f"{flag} is missing (TLS needs the CA certificate and this client's certificate)")
+    for flag, value in given.items():
+        if not Path(value).is_file():
+            raise CLIError(f"{flag}: no such file {value}")
+    from distributed.security import Security
+
+    return Security(tls_ca_file=args.tls_ca_file, tls_client_cert=args.tls_cert, tls_client_key=args.tls_key,
+                    require_encryption=True)
+
+
 def _cmd_bench(args) -> int:
     from sarcover.benchmarks.harness import run_suite
     from sarcover.benchmarks.suite import load_suite
 
     suite = load_suite(args.suite, runs=args.runs, methods=args.methods)
     out = Path(args.output) if args.output else Path("results") / suite.name
+    security = _tls(args)
     summary = run_suite(suite, out, workers=args.workers, resume=args.resume, scheduler=args.scheduler,
-                        progress=not args.quiet)
+                        security=security, progress=not args.quiet)
     counts = ", ".join(f"{n} {k}" for k, n in sorted(summary["counts"].items())) or "nothing to run"
     _print(f"{summary['suite']}: ran {summary['ran']} of {_plural(summary['jobs'], 'job')} in "
            f"{summary['wall_s']:.1f} s ({counts}) -> {summary['path']}")

@@ -126,9 +126,12 @@ def connect(address: str, security=None):
     ``security``: a :class:`distributed.security.Security` (TLS) or None."""
     from dask.distributed import Client
 
+    if address.startswith("tls://") and security is None:
+        raise HarnessError(f"the Dask scheduler at {address} speaks TLS: give its CA certificate and this "
+                           f"client's certificate (--tls-ca-file, --tls-cert, --tls-key)")
     try:
         return Client(address, timeout="15s", security=security)
-    except (OSError, TimeoutError, ValueError) as exc:
+    except (OSError, TimeoutError, ValueError, TypeError) as exc:  # TypeError: TLS settings Dask cannot use
         raise HarnessError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
 
 
