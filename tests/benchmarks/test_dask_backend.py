@@ -39,23 +39,26 @@ def test_dask_path_gives_the_same_results_as_local(tmp_path):
 
 def test_an_overrunning_job_is_killed_and_the_next_job_runs_alone(tmp_path, monkeypatch):
     """On a one-thread Dask worker, a job that spins past its deadline is killed with its child
-    process (a time_limit row; the process is gone), and the job after it has its core alone: no
-    other thread of its process used CPU while it ran (a job left running in a thread would)."""
+    process (a time_limit row; the process is gone), a job whose process dies is an error row,
+    and the job after them has its core alone: no other thread of its process used CPU while it
+    ran (a job left running in a thread would)."""
     distributed = pytest.importorskip("dask.distributed")
     marks = tmp_path / "marks"
     marks.mkdir()
     monkeypatch.setenv("SARCOVER_TEST_MARKS", str(marks))
-    suite = write_suite(tmp_path, 'methods = ["bench_methods:spin", "bench_methods:measured"]\ntime_limit = 0.3\n'
+    suite = write_suite(tmp_path, 'methods = ["bench_methods:spin", "bench_methods:die", "bench_methods:measured"]\n'
+                                  'time_limit = 0.3\n'
                                   'grace = 0.3\n[method."bench_methods:measured"]\ntime_limit = 60\n'
                                   '[[instances]]\nM = 2\nK = 2\nN = 1\ne_max = 20000\n')
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None,
                                   host="127.0.0.1", protocol="tcp") as cluster:
         summary = run_suite(load_suite(str(suite)), tmp_path / "res", scheduler=cluster.scheduler_address,
                             progress=False)
-    assert summary["counts"] == {"time_limit": 1, "optimal": 1}
+    assert summary["counts"] == {"time_limit": 1, "error": 1, "optimal": 1}
     rows = {r["method"]: r for r in rows_of(tmp_path / "res")}
     spin, measured = rows["bench_methods:spin"], rows["bench_methods:measured"]
     assert spin["status"] == "time_limit" and "killed after" in spin["reason"]
+    assert rows["bench_methods:die"]["reason"] == "job process exited with code 3"
     [mark] = marks.iterdir()
     spin_pid = int(mark.name.split(".")[1])
     with pytest.raises(ProcessLookupError):
