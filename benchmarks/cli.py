@@ -2,7 +2,9 @@
 
 Exit codes (README, "Exit codes"): 0 success (for ``solve``: a verified plan came back); 2 bad
 input, with one line on stderr naming the problem; ``solve`` only: 3 no plan (``infeasible``, or
-``no_plan`` / ``time_limit`` without a plan), 4 the method failed (``error``); 130 interrupted.
+``no_plan`` / ``time_limit`` without a plan), 4 the method failed (``error``); ``bench --strict``
+only: 1 a job of the suite ended in ``error``; 130 interrupted. Messages go through
+``logging.getLogger("sarcover")`` to stderr (:func:`setup_logging`; ``-v``/``-q``).
 A reader that closes stdout early (``| head``) ends the output quietly; the exit code stays the
 command's.
 """

@@ -166,7 +166,7 @@ def run_dask(jobs: list[dict], emit, *, scheduler, warm=(), security=None) -> No
                 row = fut.result()
             except Exception as exc:  # noqa: BLE001 - KilledWorker, pickling, ...
                 row = failed_row(job, "error", f"dask: {type(exc).__name__}: {exc}", float("nan"))
-                log.warning("%s: %s", job.get("key"), row["reason"])
+                log.info("%s: %s", job.get("key"), row["reason"])
             emit(row)
             fut.release()
     finally:

@@ -225,11 +225,11 @@ def run_local(jobs: list[dict], emit, *, workers: int, memory_mb: int = 0, run: 
                         # user is stopping the run, so its job is not stored and --resume reruns it
                         raise KeyboardInterrupt
                     reason = exit_reason(w.proc.exitcode)
-                    log.warning("%s: %s", w.job.get("key"), reason)
+                    log.debug("%s: %s; a fresh worker takes its place", w.job.get("key"), reason)
                     emit(failed(w.job, "error", reason, elapsed))
                 elif elapsed > w.job["time_limit"] + w.job["grace"]:
                     reason = overrun_reason(elapsed, w.job)
-                    log.info("%s: %s", w.job.get("key"), reason)
+                    log.debug("%s: %s; a fresh worker takes its place", w.job.get("key"), reason)
                     emit(failed(w.job, "time_limit", reason, elapsed))
                 else:
                     continue
