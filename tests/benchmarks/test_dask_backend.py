@@ -38,10 +38,7 @@ def test_dask_path_gives_the_same_results_as_local(tmp_path):
 
 
 def test_an_overrunning_job_is_killed_and_the_next_job_runs_alone(tmp_path, monkeypatch):
-    """On a one-thread Dask worker, a job that spins past its deadline is killed with its child
-    process (a time_limit row; the process is gone), a job whose process dies is an error row,
-    and the job after them has its core alone: no other thread of its process used CPU while it
-    ran (a job left running in a thread would)."""
+    """On Dask, an overrun is killed with its child, a dead child is an error, and the next job has its core alone."""
     distributed = pytest.importorskip("dask.distributed")
     marks = tmp_path / "marks"
     marks.mkdir()
@@ -106,8 +103,7 @@ def _self_signed(folder):
 
 
 def test_a_suite_runs_on_a_tls_secured_cluster_and_is_refused_without_certificates(tmp_path, capsys):
-    """On a cluster that only speaks TLS, bench with --tls-ca-file/--tls-cert/--tls-key stores its
-    rows; without them it is one line naming the flags, exit 2, nothing stored."""
+    """A TLS-only cluster runs a suite given --tls-* certificates, and refuses one without (one line, exit 2)."""
     distributed = pytest.importorskip("dask.distributed")
     from distributed.security import Security
 

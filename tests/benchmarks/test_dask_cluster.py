@@ -123,8 +123,7 @@ def _parent(pid: int) -> int:
 
 
 def test_killing_a_worker_mid_job_loses_no_job_and_stores_one_row_each(cluster, tmp_path):
-    """SIGKILL the Dask worker process whose child runs a job: Dask reruns the job elsewhere, and
-    the suite stores one row per job, the victim's from its rerun."""
+    """A Dask worker SIGKILLed mid-job: Dask reruns its job elsewhere, one row per job, the victim's from the rerun."""
     address, env, marks = cluster
     bench = _bench(tmp_path, env, address, f'name = "dask-kill"\nmethods = ["bench_methods:marked"]\n'
                    f'time_limit = 60\n[[instances]]\nM = 2\nK = 2\nN = 1\nruns = {JOBS}\ne_max = 20000\n')
@@ -143,10 +142,7 @@ def test_killing_a_worker_mid_job_loses_no_job_and_stores_one_row_each(cluster, 
 
 
 def test_a_job_that_kills_every_worker_becomes_an_error_row(cluster, tmp_path):
-    """Dask retries a job whose worker died up to allowed-failures times (lowered to 0 here to keep
-    the test short), then gives up: the harness stores an error row naming KilledWorker, one per
-    job. (Only such jobs run here: at 0 allowed failures a job queued behind one on the same
-    worker would be given up too.)"""
+    """A job that kills every worker it runs on becomes one error row naming KilledWorker once Dask gives up."""
     from dask.distributed import Client
 
     address, env, marks = cluster

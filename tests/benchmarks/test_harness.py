@@ -109,8 +109,7 @@ def test_methods_subset_then_rest_with_resume(tmp_path, capsys):
 
 
 def test_ctrl_c_in_a_worker_stops_the_run_without_storing_its_job(tmp_path, capsys):
-    """A worker killed by SIGINT means the user pressed Ctrl-C: exit 130 and the job is not stored
-    as an error (so --resume runs it again)."""
+    """A worker killed by SIGINT (Ctrl-C) exits 130 without storing its job, so --resume runs it again."""
     body = 'methods = ["bench_methods:interrupted"]\ntime_limit = 5\n[[instances]]\nM = 2\nK = 2\nN = 1\nruns = 1\n'
     suite = write_suite(tmp_path, body)
     out = tmp_path / "res"
@@ -120,9 +119,7 @@ def test_ctrl_c_in_a_worker_stops_the_run_without_storing_its_job(tmp_path, caps
 
 
 def test_ctrl_c_records_the_part_of_the_run_that_was_stored(tmp_path):
-    """A run stopped by Ctrl-C after some jobs still appends its record to runs.jsonl (marked
-    interrupted, with the jobs it stored), and the report's "how it was run" shows it as stopped;
-    a run stopped before storing anything leaves no record."""
+    """A run stopped by Ctrl-C after storing jobs leaves an interrupted runs.jsonl record; one storing none, none."""
     from sarcover.reports.reference import _walls, write_reference
 
     body = ('methods = ["greedy", "bench_methods:interrupted"]\ntime_limit = 5\n'
@@ -170,9 +167,7 @@ print(json.dumps({"before": before, "hooks": hooks, "warmed": warmed, "after": c
 
 
 def test_warm_up_leaves_nothing_for_the_jobs_to_compile():
-    """In a fresh process, the registry's warm-up hooks compile (or load from numba's disk cache)
-    every numba function that bp and the paper's pipelines then call: running them afterwards
-    adds no compiled signature. That is what keeps JIT compilation out of a job's time."""
+    """In a fresh process the warm-up hooks compile every numba function the jobs then call (none compiles later)."""
     out = subprocess.run([sys.executable, "-c", WARM_CHECK], cwd=ROOT, capture_output=True,
                          text=True, timeout=600, check=True)
     data = json.loads(out.stdout.strip().splitlines()[-1])
@@ -219,8 +214,7 @@ def test_warm_up_runs_each_hook_once_and_skips_a_broken_one(monkeypatch):
 
 
 def test_suite_with_jit_methods_compiles_before_the_workers_start(tmp_path):
-    """The harness warms up in the parent (the workers fork from it) and says so on its stream;
-    a suite without numba methods does not."""
+    """A suite with numba methods compiles in the parent before the workers fork and says so; one without does not."""
     import io
 
     jit = write_suite(tmp_path, SMALL.replace('["greedy", "cpsat"]', '["greedy", "adpc-pso"]'), "jit.toml")
@@ -235,9 +229,7 @@ def test_suite_with_jit_methods_compiles_before_the_workers_start(tmp_path):
 
 
 def test_own_folder_of_instance_files_gives_share_proven_and_certified_gaps(tmp_path):
-    """The README's recipe for instance files of one's own: a suite naming a folder of instance
-    files (no published optima next to them). The report counts what bp proves per
-    size and bounds the gap of the runs it did not prove by their certified bound."""
+    """A suite over a folder of one's own files: the report gives bp's share proven and certified gaps of the rest."""
     import shutil
 
     from sarcover.benchmarks.catalog import TOP_DIR
@@ -269,8 +261,7 @@ CRASHING = 'methods = ["greedy", "bench_methods:crash"]\n[[instances]]\nM = 3\nK
 
 
 def test_strict_exits_1_when_a_job_of_the_suite_ended_in_error(tmp_path, capsys):
-    """bench exits 0 despite an error row, --strict exits 1 naming the count, also on a resume
-    that runs nothing (the stored error still stands); a suite without errors exits 0 with --strict."""
+    """bench --strict exits 1 when a job of the suite (this run or stored) ended in error, 0 without errors."""
     suite = write_suite(tmp_path, CRASHING)
     assert main(["bench", str(suite), "-o", str(tmp_path / "a"), "--quiet"]) == 0
     assert main(["bench", str(suite), "-o", str(tmp_path / "b"), "--quiet", "--strict"]) == 1
@@ -281,8 +272,7 @@ def test_strict_exits_1_when_a_job_of_the_suite_ended_in_error(tmp_path, capsys)
 
 
 def test_verbosity_flags_set_what_the_sarcover_loggers_print(tmp_path, capsys):
-    """Default: the suite's header on stderr; -v adds one line per stored job; -q prints neither
-    (and no progress line); the flags work before or after the subcommand."""
+    """The suite header by default, one line per job with -v, nothing with -q, before or after the subcommand."""
     suite = write_suite(tmp_path, CRASHING)
     assert main(["bench", str(suite), "-o", str(tmp_path / "d")]) == 0
     err = capsys.readouterr().err
@@ -297,8 +287,7 @@ def test_verbosity_flags_set_what_the_sarcover_loggers_print(tmp_path, capsys):
 
 
 def test_run_records_carry_the_code_version_and_settings(tmp_path):
-    """Each runs.jsonl record names the code version (with its commit in a checkout) and every
-    method's time limits and parameters."""
+    """Each runs.jsonl record names the code version and every method's time limits and parameters."""
     from sarcover.benchmarks.provenance import code_version
 
     suite = write_suite(tmp_path, SMALL.replace("time_limit = 10", "time_limit = 10\n[method.cpsat]\ntime_limit = 3"))
@@ -310,8 +299,7 @@ def test_run_records_carry_the_code_version_and_settings(tmp_path):
 
 
 def test_a_failed_jobs_row_holds_its_whole_traceback(tmp_path):
-    """A method that raises leaves an error row whose info.traceback runs from the registry down
-    to the raising line (not cut to its last frames)."""
+    """A method that raises leaves an error row with its whole traceback, registry frame to raising line."""
     suite = write_suite(tmp_path, CRASHING)
     run_suite(load_suite(str(suite)), tmp_path / "r", workers=1, progress=False)
     [row] = [r for r in rows_of(tmp_path / "r") if r["status"] == "error"]

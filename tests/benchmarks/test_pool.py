@@ -36,8 +36,7 @@ runs = 2
 
 
 def test_a_groups_jobs_go_to_one_worker_task_and_long_jobs_alone():
-    """next_batch: consecutive jobs of one group form one task whatever their time limits; long
-    jobs go alone; short ungrouped jobs are batched but never with a group's."""
+    """next_batch: a group's jobs form one task, long jobs go alone, short ungrouped jobs share a batch."""
     from collections import deque
 
     from sarcover.benchmarks.pool import next_batch
@@ -52,8 +51,7 @@ def test_a_groups_jobs_go_to_one_worker_task_and_long_jobs_alone():
 
 
 def test_a_dead_workers_output_is_kept_in_the_workers_log(tmp_path):
-    """What a worker prints (solver chatter, a crash message) goes to RESULTS/workers.log, not to
-    /dev/null, and the run's progress line stays whole."""
+    """What a dying worker prints on stdout and stderr is kept in RESULTS/workers.log."""
     suite = write_suite(tmp_path, 'methods = ["bench_methods:chatter"]\n[[instances]]\nM = 2\nK = 2\nN = 1\n')
     assert main(["bench", str(suite), "-o", str(tmp_path / "res"), "--quiet"]) == 0
     [row] = rows_of(tmp_path / "res")

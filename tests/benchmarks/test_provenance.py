@@ -25,8 +25,7 @@ def test_version_label_names_the_commit_and_a_dirty_tree():
 
 @needs_git
 def test_git_commit_of_a_checkout_clean_then_dirty(tmp_path):
-    """A checkout's short commit is HEAD's; editing a tracked file makes it dirty, an untracked
-    file (results, caches) does not."""
+    """A checkout's short commit is HEAD's; a changed tracked file makes it dirty, an untracked file does not."""
     _git(tmp_path, "init", "-q")
     (tmp_path / "a.py").write_text("x = 1\n")
     _git(tmp_path, "add", "a.py")
@@ -42,8 +41,7 @@ def test_git_commit_of_a_checkout_clean_then_dirty(tmp_path):
 
 @needs_git
 def test_no_commit_outside_a_checkout_or_inside_another_repository(tmp_path):
-    """A folder outside any repository, or a subfolder of another repository (an installed
-    package in a project's tree), has no commit of its own."""
+    """Outside any repository, or in a subfolder of another repository, there is no commit of one's own."""
     assert git_commit(tmp_path) is None
     _git(tmp_path, "init", "-q")
     (tmp_path / "pkg").mkdir()
@@ -51,8 +49,7 @@ def test_no_commit_outside_a_checkout_or_inside_another_repository(tmp_path):
 
 
 def test_code_version_of_this_package_has_its_commit_when_run_from_a_checkout():
-    """This process's code version is the installed version, labelled with the commit exactly when
-    the package folder is a git checkout's top folder."""
+    """This package's code version is its installed version, labelled with its commit when in a checkout."""
     from importlib.metadata import version
 
     commit = git_commit(PACKAGE_DIR)

@@ -14,8 +14,7 @@ def job(method: str = "greedy", **extra) -> dict:
 
 
 def test_a_row_carries_the_jobs_parameters_and_the_code_version():
-    """The job's resolved parameters and the commit-labelled code version are in its row, whose
-    fields are the schema's, in order; a job without parameters has ``{}``."""
+    """A row holds the job's parameters ({} without) and the commit-labelled code version, in the schema's order."""
     row = run_one(job(params={"iterations": 300, "population": 30}))
     assert row["status"] in ("feasible", "optimal") and list(row) == list(FIELDS)
     assert row["params"] == {"iterations": 300, "population": 30}
@@ -24,8 +23,7 @@ def test_a_row_carries_the_jobs_parameters_and_the_code_version():
 
 
 def test_a_method_name_the_registry_does_not_know_is_an_error_row():
-    """run_one never raises: an unknown method (or one a variant name hides) gives an error row
-    with the reason, in the job's own method name."""
+    """An unknown method (a variant name the registry does not know yet) is an error row under the job's name."""
     row = run_one(job("adpc-pso[iterations=300]"))
     assert row["status"] == "error" and "unknown method" in row["reason"]
     assert row["method"] == "adpc-pso[iterations=300]"

@@ -68,8 +68,7 @@ GREEDY = SMALL.replace('"greedy", "cpsat"', '"greedy"')
 
 
 def test_resume_with_a_changed_time_limit_is_refused_naming_the_change(tmp_path, capsys):
-    """--resume after the suite's time limit changed: one line naming method, setting, both
-    values and the stored jobs, exit 2, nothing run; the old setting resumes as before."""
+    """--resume after a changed time limit: one line naming it, exit 2, nothing run; the old setting resumes."""
     suite = write_suite(tmp_path, GREEDY)
     out = tmp_path / "res"
     assert main(["bench", str(suite), "-o", str(out), "--quiet", "--runs", "1"]) == 0
@@ -87,8 +86,7 @@ def test_resume_with_a_changed_time_limit_is_refused_naming_the_change(tmp_path,
 
 
 def test_resume_with_changed_parameters_is_refused(tmp_path):
-    """A job whose method parameters differ from its stored row's is a changed setting; a row
-    written before rows carried parameters is compared on method and time limit only."""
+    """Changed params are a changed setting; a row without params is compared on method and time limit only."""
     import json
 
     import pytest

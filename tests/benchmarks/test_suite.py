@@ -81,9 +81,7 @@ seed = 10
 
 
 def test_builtin_suites_load_with_registered_methods():
-    """Every built-in suite parses and names only registered methods; paper-n is the paper's
-    Fig. 3 grid (M=20, K=3, N=2..6, heuristics only); the TOP suites hold every shipped file of
-    their sets, each with a published optimum or a published best known value."""
+    """Built-in suites load with registered methods; paper-n is Fig. 3's grid; TOP suites hold every shipped file."""
     from sarcover.benchmarks.catalog import TOP_DIR
     from sarcover.benchmarks.registry import METHODS
     from sarcover.benchmarks.suite import builtin_suites
