@@ -39,15 +39,21 @@ def test_a_groups_jobs_go_to_one_worker_task_and_long_jobs_alone():
     """next_batch: a group's jobs form one task, long jobs go alone, short ungrouped jobs share a batch."""
     from collections import deque
 
-    from sarcover.benchmarks.pool import next_batch
+    from sarcover.benchmarks.pool import BATCH_TIME_LIMIT, next_batch
+
+    long, short = BATCH_TIME_LIMIT + 1, BATCH_TIME_LIMIT
 
     def j(tl, group=None):
         return {"time_limit": tl, "group": group}
 
-    pending = deque([j(60, "a"), j(60, "a"), j(1, "a"), j(60, "b"), j(60), j(1), j(1), j(1, "c")])
+    pending = deque([j(long, "a"), j(long, "a"), j(short, "a"), j(long, "b"), j(long)] + [j(short)] * 9
+                    + [j(short, "c")])
     assert [len(next_batch(pending, 1)) for _ in range(3)] == [3, 1, 1]
-    assert next_batch(pending, 1) == [j(1)]  # a quarter of what is left: one
-    assert next_batch(pending, 1) == [j(1)] and next_batch(pending, 1) == [j(1, "c")]
+    assert next_batch(pending, 1) == [j(short)] * 2  # up to a quarter of what is left: 9 // 4 = 2
+    rest = []
+    while pending:
+        rest.append(next_batch(pending, 1))
+    assert rest[-1] == [j(short, "c")] and all(batch[0]["group"] is None for batch in rest[:-1])
 
 
 def test_a_dead_workers_output_is_kept_in_the_workers_log(tmp_path):
