@@ -3,7 +3,9 @@
 Exit codes (README, "Exit codes"): 0 success (for ``solve``: a verified plan came back); 2 bad
 input, with one line on stderr naming the problem; ``solve`` only: 3 no plan (``infeasible``, or
 ``no_plan`` / ``time_limit`` without a plan), 4 the method failed (``error``); ``verify`` 1 for an
-invalid plan; ``report --strict`` 1 when the report lists a conflict; 130 interrupted.
+invalid plan; ``bench --strict`` 1 when a job of the suite ended in ``error``; ``report --strict`` 1
+when the report lists a conflict; 130 interrupted. Messages go through
+``logging.getLogger("sarcover")`` to stderr (:func:`setup_logging`; ``-v``/``-q``).
 A reader that closes stdout early (``| head``) ends the output quietly; the exit code stays the
 command's.
 """
@@ -13,6 +15,7 @@ from __future__ import annotations
 import argparse
 import errno
 import json
+import logging
 import math
 import os
 import sys
@@ -24,6 +27,7 @@ from sarcover.formulations.errors import SarcoverError
 from sarcover.formulations.limits import shown
 
 EXIT_OK = 0
+EXIT_JOBS_FAILED = 1  # bench --strict: a job ended in error
 EXIT_BAD_INPUT = 2
 EXIT_NO_PLAN = 3
 EXIT_METHOD_ERROR = 4
@@ -358,7 +362,13 @@ def _add_bench(sub):
     p.add_argument("--runs", type=_int_at_least(1), help="random instances per setting (replaces the suite's runs)")
     p.add_argument("--methods", type=_method_list, help="run only these of the suite's methods, comma-separated")
     p.add_argument("--scheduler", help="run on a Dask cluster, e.g. tcp://HOST:8786")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--tls-ca-file", metavar="PEM", help="with --scheduler tls://...: the CA certificate that "
+                   "signed the cluster's certificates")
+    p.add_argument("--tls-cert", metavar="PEM", help="this client's certificate (may hold its key too)")
+    p.add_argument("--tls-key", metavar="PEM", help="this client's private key, if not in --tls-cert")
+    p.add_argument("--strict", action="store_true", help=f"exit {EXIT_JOBS_FAILED} when any job of the suite "
+                   "ended in error, in this run or a stored one (a crash, a dead worker, a rejected plan)")
+    _add_verbosity(p, quiet_help="no progress bar, warnings only")
     p.set_defaults(func=_cmd_bench)
 
 
@@ -371,17 +381,42 @@ def _method_list(text: str) -> list[str]:
     return names
 
 
+def _tls(args):
+    """The Dask ``Security`` of the --tls-* flags (None without them), checked before anything runs."""
+    given = {flag: value for flag, value in (("--tls-ca-file", args.tls_ca_file), ("--tls-cert", args.tls_cert),
+                                             ("--tls-key", args.tls_key)) if value is not None}
+    if not given:
+        return None
+    if not args.scheduler:
+        raise CLIError(f"{next(iter(given))} is for a Dask cluster; give --scheduler tls://HOST:PORT too")
+    for flag in ("--tls-ca-file", "--tls-cert"):
+        if flag not in given:
+            raise CLIError(f"{flag} is missing (TLS needs the CA certificate and this client's certificate)")
+    for flag, value in given.items():
+        if not Path(value).is_file():
+            raise CLIError(f"{flag}: no such file {value}")
+    from distributed.security import Security
+
+    return Security(tls_ca_file=args.tls_ca_file, tls_client_cert=args.tls_cert, tls_client_key=args.tls_key,
+                    require_encryption=True)
+
+
 def _cmd_bench(args) -> int:
     from sarcover.benchmarks.harness import run_suite
     from sarcover.benchmarks.suite import load_suite
 
     suite = load_suite(args.suite, runs=args.runs, methods=args.methods)
     out = Path(args.output) if args.output else Path("results") / suite.name
+    security = _tls(args)
     summary = run_suite(suite, out, workers=args.workers, resume=args.resume, scheduler=args.scheduler,
-                        progress=not args.quiet)
+                        security=security, progress=not args.quiet)
     counts = ", ".join(f"{n} {k}" for k, n in sorted(summary["counts"].items())) or "nothing to run"
     _print(f"{summary['suite']}: ran {summary['ran']} of {_plural(summary['jobs'], 'job')} in "
            f"{summary['wall_s']:.1f} s ({counts}) -> {summary['path']}")
+    if args.strict and summary["errors"]:  # stored errors count too: --resume does not rerun them
+        logging.getLogger("sarcover").error("%s of the suite ended in error (--strict); their reasons are in %s",
+                                            _plural(summary["errors"], "job"), summary["path"])
+        return EXIT_JOBS_FAILED
     return EXIT_OK
 
 
@@ -481,13 +516,61 @@ def _version() -> str:
         return "unknown"
 
 
+class _Stderr(logging.StreamHandler):
+    """A handler that writes to whatever ``sys.stderr`` is when a record comes (a test swaps it)."""
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, _):
+        pass
+
+
+class _Format(logging.Formatter):
+    """``message`` for information, ``warning: message`` above it, ``[logger] message`` below it."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        text = record.getMessage()
+        if record.levelno >= logging.WARNING:
+            return f"sarcover: {record.levelname.lower()}: {text}"
+        if record.levelno < logging.INFO:
+            return f"[{record.name}] {text}"
+        return text
+
+
+_HANDLER = _Stderr()
+_HANDLER.setFormatter(_Format())
+
+
+def setup_logging(verbose: int = 0, quiet: bool = False) -> None:
+    """The ``sarcover`` loggers on stderr: information by default, debug with ``-v`` (each job's
+    row as it is stored, worker replacements), warnings only with ``-q``."""
+    logger = logging.getLogger("sarcover")
+    logger.setLevel(logging.WARNING if quiet else logging.DEBUG if verbose else logging.INFO)
+    if _HANDLER not in logger.handlers:
+        logger.addHandler(_HANDLER)
+
+
+def _add_verbosity(parser, quiet_help: str = "warnings only") -> None:
+    """``-v``/``-q`` on ``parser``; on a subcommand they keep what the main parser read."""
+    top = parser.prog == "sarcover"
+    parser.add_argument("-v", "--verbose", action="count", default=0 if top else argparse.SUPPRESS,
+                        help="more messages on stderr (debug: one line per job)")
+    parser.add_argument("-q", "--quiet", action="store_true", default=False if top else argparse.SUPPRESS,
+                        help=quiet_help)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="sarcover", description="Exact and heuristic benchmarking for multi-view SAR-UAV coverage "
                      "planning", epilog=EXIT_CODES.replace("exit codes:", "exit codes of `sarcover solve`:")
                      + "\nevery other command exits 0 on success and 2 on bad input; `verify` exits 1 for an "
-                     "invalid plan,\n`report --strict` 1 when the report lists a conflict.",
+                     "invalid plan,\n`report --strict` 1 when the report lists a conflict,"
+                     + f"\n`bench --strict` {EXIT_JOBS_FAILED} when a job of the suite ended in error.",
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"sarcover {_version()}")
+    _add_verbosity(parser)
     sub = parser.add_subparsers(dest="command", parser_class=_Parser, required=True)
     for add in COMMANDS:
         add(sub)
@@ -499,6 +582,7 @@ def main(argv: list[str] | None = None) -> int:
     _stdout_gone = False
     try:
         args = build_parser().parse_args(argv)
+        setup_logging(args.verbose, args.quiet)
         return args.func(args)
     except SarcoverError as exc:
         print(f"sarcover: error: {_one_line(exc)}", file=sys.stderr)

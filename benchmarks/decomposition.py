@@ -33,17 +33,22 @@ OPT, computed and checked), so their gap is routing loss alone.
 
 :func:`decompose` runs it at scale: cases with their OPT (from the stored rows of a results
 directory or computed), one JSON line per (instance, method, seed) appended to a file as each
-ends, rows already there skipped, progress on stderr.
+ends, rows already there skipped, progress on stderr. The rows are computed on the benchmark
+harness's worker pool, each with a deadline and a memory cap: a row whose process is killed
+becomes a ``time_limit`` or ``error`` row instead of a run that waits forever.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import sys
 import time
+import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from sarcover.benchmarks.suite import DEFAULT_MEMORY_MB
 from sarcover.formulations.clustered import oracle_clusters, solve_clustered, split_groups
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
@@ -212,7 +217,7 @@ def cases_from_results(results_dir: str | Path, *, exact=("bp", "milp", "cpsat")
     stored exact rows: the best proven optimum (status ``optimal``, verified) if any, else the
     smallest stored bound (``opt_proven`` False); the best verified plan of any row is the oracle's.
     Instances without an optimum or a bound are skipped."""
-    from sarcover.benchmarks.harness import build_instance
+    from sarcover.benchmarks.rows import build_instance
     from sarcover.reports.results import read_rows
 
     rows, _ = read_rows(results_dir)
@@ -275,7 +280,7 @@ def row_key(row: dict) -> str:
 
 def decompose(source, out_path: str | Path, *, methods=tuple(METHODS), seeds=(0,), time_limit: float = 60.0,
               clustered_time_limit: float | None = 120.0, unvisited: str = "assign", workers: int = 1,
-              stream=sys.stderr) -> list[dict]:
+              memory_mb: int = DEFAULT_MEMORY_MB, grace: float | None = None, stream=sys.stderr) -> list[dict]:
     """Decompose every (case, method, seed) into ``out_path`` (JSON lines), resumably.
 
     ``source``: a results directory (:func:`cases_from_results`) or a list of :class:`Case`.
@@ -283,10 +288,17 @@ def decompose(source, out_path: str | Path, *, methods=tuple(METHODS), seeds=(0,
     appended and flushed when it is done, so a killed run loses at most the rows in flight (one
     per worker). OPT|C solves already stored (same instance and clustering) are reused.
     ``time_limit`` is the methods' (a safety net for the pipelines), ``clustered_time_limit`` each
-    OPT|C solve's. ``workers`` > 1 decomposes that many instances at a time in forked processes
-    (one thread each; an instance's rows stay in one process, so its methods share their OPT|C
-    solves); rows are then appended in the order they finish. Returns all rows of the file.
+    OPT|C solve's. The rows are computed on the benchmark harness's worker pool
+    (:func:`sarcover.benchmarks.pool.run_local`): ``workers`` processes of one thread each, an
+    instance's rows in one process (its methods share their OPT|C solves), each row with a
+    deadline (the method's limit and two OPT|C solves' plus ``grace``, default 5 s + 20 %) and
+    each process with an address-space cap of ``memory_mb``; a row whose process was killed at
+    its deadline or died (the OOM killer) is stored as ``time_limit`` or ``error`` with the
+    reason, and the run goes on. Worker output goes to ``out_path`` with suffix
+    ``.workers.log``. Rows are appended in the order they finish. Returns all rows of the file.
     """
+    from sarcover.benchmarks.pool import run_local
+
     cases = cases_from_results(source) if isinstance(source, (str, Path)) else list(source)
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
@@ -294,15 +306,17 @@ def decompose(source, out_path: str | Path, *, methods=tuple(METHODS), seeds=(0,
     out_path.parent.mkdir(parents=True, exist_ok=True)
     done = read_decomposition(out_path)
     have = {row_key(r) for r in done}
-    cache = ClusteredCache(clustered_time_limit)
+    stored: dict[str, dict] = {c.name: {} for c in cases}  # per instance: OPT|C entries by clustering
     for r in done:  # stored OPT|C values, by clustering (C and, where it was solved, C')
-        if r.get("clusters") is not None and r.get("opt_c_status") is not None:
-            cache.remember(r["instance"], r["clusters"], _entry_from_row(r, "opt_c"))
-        if r.get("clusters_plan") is not None and r.get("opt_cp_status") is not None:
-            cache.remember(r["instance"], r["clusters_plan"], _entry_from_row(r, "opt_cp"))
-    todo = [(c, [(m, s) for m in methods for s in seeds if f"{c.name}|{m}|{s}" not in have]) for c in cases]
-    todo = [(c, jobs) for c, jobs in todo if jobs]
-    total = sum(len(jobs) for _, jobs in todo)
+        entries = stored.setdefault(r["instance"], {})
+        _remember_row(entries, r)
+    limit = time_limit + 2 * (clustered_time_limit if clustered_time_limit is not None else math.inf)
+    jobs = [{"key": f"{c.name}|{m}|{s}", "group": c.name, "case": c, "method": m, "seed": s,
+             "time_limit": limit, "grace": grace if grace is not None else 5.0 + 0.2 * min(limit, 3600.0),
+             "method_time_limit": time_limit, "clustered_time_limit": clustered_time_limit,
+             "unvisited": unvisited, "stored": stored[c.name]}
+            for c in cases for m in methods for s in seeds if f"{c.name}|{m}|{s}" not in have]
+    total = len(jobs)
     drop_torn_tail(out_path)  # a row in flight when a run was killed
     t0 = time.perf_counter()
     count = 0
@@ -312,58 +326,54 @@ def decompose(source, out_path: str | Path, *, methods=tuple(METHODS), seeds=(0,
             fh.write(json.dumps(row) + "\n")
             fh.flush()
             done.append(row)
+            _remember_row(stored.setdefault(row["instance"], {}), row)  # for the instance's jobs not yet sent
             count += 1
             if stream is not None:
                 print(f"decompose: {count}/{total} {row_key(row)}: gap {row.get('gap')} = clustering "
                       f"{row.get('clustering_loss')} + cross {row.get('cross_cluster')} + routing "
                       f"{row.get('routing_loss')} (OPT|C {row.get('opt_c')} in {row.get('opt_c_s')} s; "
-                      f"{time.perf_counter() - t0:.0f} s so far)", file=stream, flush=True)
+                      f"{time.perf_counter() - t0:.0f} s so far)"
+                      + (f" [{row['status']}: {row['reason']}]" if row.get("reason") else ""), file=stream, flush=True)
 
-        if workers == 1 or len(todo) <= 1:
-            for case, jobs in todo:
-                for method, seed in jobs:
-                    store(decompose_one(case, method, seed=seed, cache=cache, time_limit=time_limit,
-                                        unvisited=unvisited))
-        else:
-            _decompose_parallel(todo, total, cache, time_limit, unvisited, workers, store)
+        run_local(jobs, store, workers=workers, memory_mb=memory_mb, run=run_job, failed=failed_job_row,
+                  output=out_path.with_name(out_path.name + ".workers.log"))
     return done
 
 
-_QUEUE = None  # the forked workers' channel back to the parent (set before the fork)
+def _remember_row(entries: dict, row: dict) -> None:
+    """Add a row's solved OPT|C values (of C, and of C' where solved) to ``entries`` (by clustering)."""
+    if row.get("clusters") is not None and row.get("opt_c_status") is not None:
+        entries[_key(row["clusters"])] = _entry_from_row(row, "opt_c")
+    if row.get("clusters_plan") is not None and row.get("opt_cp_status") is not None:
+        entries[_key(row["clusters_plan"])] = _entry_from_row(row, "opt_cp")
 
 
-def _decompose_case(case: Case, jobs, cache: ClusteredCache, time_limit: float, unvisited: str) -> int:
-    for method, seed in jobs:
-        _QUEUE.put(decompose_one(case, method, seed=seed, cache=cache, time_limit=time_limit, unvisited=unvisited))
-    return len(jobs)
+_CACHES: dict[str, ClusteredCache] = {}  # a worker process's OPT|C solves, per instance
 
 
-def _decompose_parallel(todo, total: int, cache: ClusteredCache, time_limit: float, unvisited: str, workers: int,
-                        store) -> None:
-    """One task per instance in a pool of forked processes; each of the ``total`` rows travels
-    back on a queue as it ends and ``store`` writes it, so the file grows row by row as in the
-    serial loop."""
-    import multiprocessing as mp
-    import queue
-
-    global _QUEUE
-    ctx = mp.get_context("fork")
-    _QUEUE = ctx.Queue()
+def run_job(job: dict) -> dict:
+    """A pool worker's row of one decomposition job (never raises: a failure is an ``error`` row)."""
+    case = job["case"]
+    cache = _CACHES.get(case.name)
+    if cache is None or cache.time_limit != job["clustered_time_limit"]:
+        cache = _CACHES[case.name] = ClusteredCache(job["clustered_time_limit"])
+    for clustering, entry in job["stored"].items():
+        cache.store.setdefault((case.name, clustering), entry)
+    t0 = time.perf_counter()
     try:
-        with ctx.Pool(min(workers, len(todo))) as pool:
-            tasks = []
-            for case, jobs in todo:
-                own = ClusteredCache(cache.time_limit)  # this instance's stored OPT|C solves only
-                own.store = {k: v for k, v in cache.store.items() if k[0] == case.name}
-                tasks.append(pool.apply_async(_decompose_case, (case, jobs, own, time_limit, unvisited)))
-            for _ in range(total):
-                while True:
-                    try:
-                        store(_QUEUE.get(timeout=0.5))
-                        break
-                    except queue.Empty:
-                        for t in tasks:
-                            if t.ready():
-                                t.get()  # re-raises a worker's exception here
-    finally:
-        _QUEUE = None
+        return decompose_one(case, job["method"], seed=job["seed"], cache=cache, time_limit=job["method_time_limit"],
+                             unvisited=job["unvisited"])
+    except Exception as exc:  # noqa: BLE001 - one failing row must not stop the run
+        row = failed_job_row(job, "error", f"{type(exc).__name__}: {exc}", time.perf_counter() - t0)
+        row["traceback"] = traceback.format_exc().strip().splitlines()
+        return row
+
+
+def failed_job_row(job: dict, status: str, reason: str, elapsed: float) -> dict:
+    """The row of a job that returned no decomposition (killed at its deadline, died, raised)."""
+    case = job["case"]
+    clusterer, router = METHODS[job["method"]]
+    return {"instance": case.name, **case.meta, "method": job["method"], "clusterer": clusterer, "router": router,
+            "seed": job["seed"], "opt": case.opt, "opt_proven": case.opt_proven, "opt_source": case.opt_source,
+            "gap": None, "clustering_loss": None, "cross_cluster": None, "routing_loss": None,
+            "status": status, "reason": reason, "wall_s": round(elapsed, 3)}

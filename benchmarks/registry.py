@@ -275,9 +275,10 @@ def run_method(name: str, instance: TOPInstance, *, seed: int = 0,
     try:
         result = spec.run(instance, seed=seed, time_limit=time_limit, **resolved)
     except Exception as exc:  # a method bug must not stop a benchmark
-        tb = traceback.format_exc(limit=-3).strip().splitlines()
+        tb = traceback.format_exc().strip().splitlines()
         return VerifiedResult.failed(spec.name, Termination.ERROR, f"{type(exc).__name__}: {exc}",
                                      time.perf_counter() - t0, info={**info, "traceback": tb})
     result.info = {**result.info, **info}
     return verified_result(instance, result, method=spec.name, runtime_s=time.perf_counter() - t0)
+
 

@@ -9,7 +9,8 @@ through :func:`read_rows` (pandas reads a clean file natively too:
 
 Row fields (``schema`` 2; :data:`FIELDS` lists them):
 
-- identity: ``key`` (``instance|method|seed``), ``suite``, ``instance``, ``method``, ``exact``,
+- identity: ``key`` (``instance|method|seed``), ``suite``, ``instance``, ``method``, ``params`` (the
+  method's resolved parameters; absent from rows written before it was added), ``exact``,
   ``seed`` (method seed), ``run`` (index within the setting and method), ``source`` (how to rebuild
   the instance: generator parameters or file path), ``kind`` (``sar``/``top``), ``M``, ``K``, ``N``,
   ``instance_seed`` (random sets), ``n_nodes``, ``n_groups``, ``n_vehicles``, ``reference``
@@ -25,7 +26,8 @@ Row fields (``schema`` 2; :data:`FIELDS` lists them):
   does not inflate; it misses threads a method starts itself, and is null in rows of a killed job
   and in rows written before it was added), ``time_limit``, ``threads`` (what the method reported
   using, or null), ``workers`` (jobs run in parallel);
-- provenance: ``host``, ``platform``, ``cpu_count``, ``versions`` (package versions), ``pid``,
+- provenance: ``host``, ``platform``, ``cpu_count``, ``versions`` (package versions; ``sarcover``'s
+  with its git commit, ``0.1.0+g1a2b3c4d[.dirty]``, when it ran from a checkout), ``pid``,
   ``finished_at`` (UTC ISO time).
 
 Schema 1 rows (written before ``termination`` and ``solution`` existed) are read and upgraded
@@ -44,7 +46,7 @@ from sarcover.formulations.result import VerifiedResult, split_status
 SCHEMA_VERSION = 2
 RESULTS_FILE = "results.jsonl"
 
-IDENTITY = ("schema", "key", "suite", "instance", "method", "exact", "seed", "run", "source", "kind", "M", "K",
+IDENTITY = ("schema", "key", "suite", "instance", "method", "params", "exact", "seed", "run", "source", "kind", "M", "K",
             "N", "instance_seed", "n_nodes", "n_groups", "n_vehicles", "reference", "best_known")
 OUTCOME = ("termination", "solution", "status", "objective", "bound", "coverage", "covered", "routes", "energy",
            "energy_used", "e_max", "valid", "reason", "info")

@@ -347,7 +347,7 @@ def _anytime(df: pd.DataFrame, inst: pd.DataFrame, out: Path, doc: _Doc):
 
 def _parquet(df: pd.DataFrame, path: Path) -> bool:
     flat = df.copy()
-    for col in ("routes", "energy", "covered", "info", "source", "versions"):
+    for col in ("routes", "energy", "covered", "info", "source", "versions", "params"):
         if col in flat:
             flat[col] = [None if v is None or (isinstance(v, float) and np.isnan(v)) else json.dumps(v)
                          for v in flat[col]]
@@ -421,7 +421,7 @@ def write_report(results_dir: str | Path, out_dir: str | Path) -> str:
     _gap_distributions(gapped, out, doc)
     _time_to_optimality(gapped, out, doc)
     _anytime(df, inst, out, doc)
-    gapped.drop(columns=["routes", "info", "source", "versions", "energy", "covered"], errors="ignore").to_csv(
+    gapped.drop(columns=["routes", "info", "source", "versions", "params", "energy", "covered"], errors="ignore").to_csv(
         out / "runs.csv", index=False)
     parquet = _parquet(df, out / "results.parquet")
     (out / "report.md").write_text(doc.markdown())

@@ -70,3 +70,45 @@ def marked(instance, *, seed=0, time_limit=None):
     (Path(os.environ["SARCOVER_TEST_MARKS"]) / f"{instance.name}.{os.getpid()}").touch()
     time.sleep(1.5)
     return all_optimal(instance)
+
+
+def spin(instance, *, seed=0, time_limit=None):
+    """Burns CPU in pure Python (holding the GIL) forever, after leaving a mark named by its pid."""
+    from pathlib import Path
+
+    marks = os.environ.get("SARCOVER_TEST_MARKS")
+    if marks:
+        (Path(marks) / f"spin.{os.getpid()}").touch()
+    x = 0
+    while True:
+        x += 1
+
+
+def measured(instance, *, seed=0, time_limit=None):
+    """0.5 s of pure-Python CPU work; its info says how much CPU other threads of its process took
+    meanwhile (a job left running beside it shows up there)."""
+    wall, cpu, proc = time.perf_counter(), time.thread_time(), time.process_time()
+    x = 0
+    while time.thread_time() - cpu < 0.5:
+        x += 1
+    result = all_optimal(instance)
+    result.info["other_threads_cpu_s"] = (time.process_time() - proc) - (time.thread_time() - cpu)
+    result.info["own_wall_s"] = time.perf_counter() - wall
+    return result
+
+
+def kill_parent(instance, *, seed=0, time_limit=None):
+    """SIGKILLs its parent process (on Dask: the worker process the job's child belongs to)."""
+    import signal
+
+    os.kill(os.getppid(), signal.SIGKILL)
+    time.sleep(5.0)
+
+
+def chatter(instance, *, seed=0, time_limit=None):
+    """Prints on stdout and stderr, then exits its process with code 5."""
+    import sys
+
+    print("chatter on stdout", flush=True)
+    print("last words on stderr", file=sys.stderr, flush=True)
+    os._exit(5)

@@ -1,4 +1,5 @@
-"""Suites: a method's parameters and grids, expanded into named variants when the suite loads."""
+"""Suite files (benchmarks/suite.py) as the bench command reads them: parameters and grids expanded into named
+variants when the suite loads, bad input, overrides, runs, built-ins."""
 
 import pytest
 
@@ -6,6 +7,9 @@ from sarcover.benchmarks.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from sarcover.benchmarks.registry import METHODS
 from sarcover.benchmarks.suite import SuiteError, load_suite
 from sarcover.formulations.records import read_rows
+
+from bench_suites import write_suite
+
 
 GRID = """
 name = "grid"
@@ -129,7 +133,7 @@ def test_bad_parameters_in_a_suite_are_one_line_before_anything_runs(tmp_path, c
 ])
 def test_bad_suite_files_give_one_line_error(tmp_path, capsys, body, needle):
     """Unknown method, bad parameter, missing file: one line naming the problem, exit 2, nothing run."""
-    suite = write(tmp_path, body, "bad.toml")
+    suite = write_suite(tmp_path, body, "bad.toml")
     assert main(["bench", str(suite), "-o", str(tmp_path / "res"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and needle in err and "bad.toml" in err, err
@@ -138,7 +142,7 @@ def test_bad_suite_files_give_one_line_error(tmp_path, capsys, body, needle):
 
 def test_an_instance_set_overrides_a_methods_time_limit(tmp_path):
     """[instances.method.NAME] sets a method's time limit for that set only, over [method.NAME]."""
-    suite = load_suite(str(write(tmp_path, """
+    suite = load_suite(str(write_suite(tmp_path, """
 methods = ["greedy", "bp"]
 time_limit = 10
 [method.bp]
@@ -158,9 +162,16 @@ time_limit = 300
     assert limits == {(2, "greedy"): 10, (2, "bp"): 60, (4, "greedy"): 10, (4, "bp"): 300}
 
 
+def test_unknown_suite_name_lists_builtins(capsys):
+    """A suite that is neither built in nor a file is a one-line error listing the built-ins."""
+    assert main(["bench", "no-such-suite", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "quick" in err and "paper-n" in err and len(err.strip().splitlines()) == 1
+
+
 def test_runs_define_instances_and_seeds(tmp_path):
     """runs = new random instances per setting (--runs overrides); seeds = method seeds per instance."""
-    suite = write(tmp_path, """
+    suite = write_suite(tmp_path, """
 methods = ["greedy"]
 seeds = 2
 [[instances]]
@@ -179,19 +190,21 @@ seed = 10
 
 
 def test_builtin_suites_load_with_registered_methods():
-    """Every built-in suite parses, names only registered methods, and paper-n is M=20, K=3, N=2..6."""
+    """Built-in suites load with registered methods; paper-n is Fig. 3's grid; TOP suites hold every shipped file."""
+    from sarcover.benchmarks.catalog import TOP_DIR
+    from sarcover.benchmarks.registry import METHODS
     from sarcover.benchmarks.suite import builtin_suites
 
     assert {"quick", "exact-small", "paper-n", "paper-k", "top-chao"} <= set(builtin_suites())
     for name in builtin_suites():
         suite = load_suite(name, runs=None if name.startswith("top-") else 2)
-        assert suite.jobs, name
+        assert suite.jobs and set(suite.methods) <= set(METHODS), name
     paper_n = load_suite("paper-n", runs=2)
     assert {(j.source["M"], j.source["K"], j.source["N"]) for j in paper_n.jobs} == {(20, 3, n) for n in range(2, 7)}
     assert not any(j.source["exact"] for j in paper_n.jobs)
-    assert load_suite("top-chao").n_instances == 117
+    shipped = {p.stem for p in TOP_DIR.glob("p*.txt")}
+    assert {j.instance for j in load_suite("top-chao").jobs} == {n for n in shipped if n[1] in "123"}
     top47 = load_suite("top-4-7")
-    assert top47.n_instances == 192 and top47.methods == ["bp"]
+    assert {j.instance for j in top47.jobs} == {n for n in shipped if n[1] in "4567"}
     refs = [(j.source["reference"], j.source["best_known"]) for j in top47.jobs]
     assert all((r is None) != (b is None) for r, b in refs)  # each file: a proven optimum or a best known value
-    assert sum(r is not None for r, _ in refs) == 50

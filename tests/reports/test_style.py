@@ -8,7 +8,7 @@ import matplotlib
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-from sarcover.benchmarks.harness import run_one
+from sarcover.benchmarks.rows import run_one
 from sarcover.benchmarks.registry import METHODS
 from sarcover.reports import optimum, reference, report
 from sarcover.reports.style import GROUPS, look, ordered

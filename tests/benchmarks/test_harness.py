@@ -1,10 +1,6 @@
-"""Benchmark harness: suites end to end through the CLI, failures isolated, kill + resume, Dask."""
+"""run_suite end to end (benchmarks/harness.py): rows, reports, warm-up, Ctrl-C, strict exit codes."""
 
-import os
-import signal
-import subprocess
-import sys
-import time
+import json
 from pathlib import Path
 
 import pandas as pd
@@ -13,40 +9,15 @@ import pytest
 from sarcover.benchmarks.cli import main
 from sarcover.benchmarks.harness import run_suite
 from sarcover.benchmarks.suite import load_suite
-from sarcover.formulations.records import FIELDS, SCHEMA_VERSION, read_rows
+from sarcover.formulations.records import FIELDS, SCHEMA_VERSION
 
-TESTS = Path(__file__).resolve().parent
-ROOT = TESTS.parent
-
-
-def write_suite(tmp_path, body: str, name: str = "s.toml") -> Path:
-    path = tmp_path / name
-    path.write_text(body)
-    return path
-
-
-def rows_of(directory) -> list[dict]:
-    rows, skipped = read_rows(directory)
-    assert not any(skipped.values()), skipped
-    return rows
-
-
-SMALL = """
-name = "small"
-methods = ["greedy", "cpsat"]
-time_limit = 10
-[[instances]]
-M = 4
-K = 2
-N = [2, 3]
-runs = 2
-[[instances]]
-files = ["p2.2.b"]
-"""
+from bench_suites import SMALL, rows_of, write_suite
 
 
 def test_small_suite_end_to_end_cli(tmp_path, capsys):
     """bench stores one verified row per job with provenance; report writes md, html, png, csv."""
+    from sarcover.benchmarks.provenance import code_version
+
     suite = write_suite(tmp_path, SMALL)
     out = tmp_path / "res"
     assert main(["bench", str(suite), "-o", str(out), "--workers", "2", "--quiet"]) == 0
@@ -59,6 +30,7 @@ def test_small_suite_end_to_end_cli(tmp_path, capsys):
             assert r["objective"] == pytest.approx(r["coverage"] * r["M"] * r["K"])
         assert r["energy_used"] <= r["e_max"] * r["n_vehicles"] * (1 + 1e-9)
         assert r["versions"]["numpy"] and r["host"] and r["schema"] == SCHEMA_VERSION and r["workers"] == 2
+        assert r["versions"]["sarcover"] == code_version() and r["params"] == {}
         assert list(r) == list(FIELDS)  # the one schema, in its order
         assert (r["termination"], r["solution"]) in (("completed", "feasible"), ("optimal", "optimal"))
         assert 0 < r["cpu_s"] <= r["wall_s"] + 0.05  # the job thread's CPU time, within its wall time
@@ -103,134 +75,6 @@ files = ["line10.txt"]
     assert inst["opt"].iloc[0] == 10 and inst["conflict"].isna().all()
 
 
-def test_crashing_dying_hanging_and_hogging_methods_do_not_stop_the_suite(tmp_path):
-    """Raise / dead worker / memory hog: error rows; a hang is killed as time_limit; greedy still runs."""
-    suite = write_suite(tmp_path, """
-methods = ["bench_methods:crash", "bench_methods:die", "bench_methods:hang", "bench_methods:hog", "greedy"]
-time_limit = 0.3
-grace = 0.3
-memory_mb = 1500
-[[instances]]
-M = 3
-K = 2
-N = 2
-runs = 2
-""")
-    out = tmp_path / "res"
-    t0 = time.monotonic()
-    assert main(["bench", str(suite), "-o", str(out), "--workers", "2", "--quiet"]) == 0
-    assert time.monotonic() - t0 < 20
-    by = {}
-    for r in rows_of(out):
-        by.setdefault(r["method"], []).append(r)
-    assert all(len(v) == 2 for v in by.values()) and len(by) == 5
-    assert all(r["status"] == "error" and "boom" in r["reason"] for r in by["bench_methods:crash"])
-    assert all(r["status"] == "error" and "exited with code 3" in r["reason"] for r in by["bench_methods:die"])
-    assert all(r["status"] == "time_limit" and "killed" in r["reason"] for r in by["bench_methods:hang"])
-    assert all(r["status"] == "error" and "MemoryError" in r["reason"] for r in by["bench_methods:hog"])
-    assert all(r["status"] == "feasible" and r["valid"] for r in by["greedy"])
-
-
-def test_sigkill_mid_run_then_resume_gives_one_row_per_job(tmp_path):
-    """SIGKILL the bench process mid-way (plus a torn last line); --resume completes, no duplicates."""
-    suite = write_suite(tmp_path, """
-methods = ["bench_methods:slow_all"]
-[[instances]]
-M = 2
-K = 2
-N = 1
-runs = 12
-e_max = 20000  # one UAV can fly all four viewpoints
-""")
-    out = tmp_path / "res"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS), str(ROOT)])}
-    proc = subprocess.Popen([sys.executable, "-m", "sarcover.benchmarks.cli", "bench", str(suite), "-o", str(out),
-                             "--workers", "2", "--quiet"], env=env, start_new_session=True,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    results = out / "results.jsonl"
-    try:
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:
-            if results.exists() and results.read_text().count("\n") >= 3:
-                break
-            time.sleep(0.05)
-        os.kill(proc.pid, signal.SIGKILL)
-        proc.wait(10)
-    finally:
-        try:
-            os.killpg(proc.pid, signal.SIGKILL)  # the workers die with their parent; be sure
-        except ProcessLookupError:
-            pass
-    before = results.read_text().count("\n")
-    assert 3 <= before < 12, "the kill did not land mid-run"
-    with results.open("a") as fh:  # a row torn in half by the kill
-        fh.write('{"schema": 1, "key": "torn')
-    assert main(["bench", str(suite), "-o", str(out), "--resume", "--quiet"]) == 0
-    rows = rows_of(out)
-    assert len(rows) == 12 and len({r["key"] for r in rows}) == 12
-    assert all(r["status"] == "optimal" for r in rows)
-    assert main(["bench", str(suite), "-o", str(out), "--resume", "--quiet"]) == 0  # nothing left to do
-    assert len(rows_of(out)) == 12
-
-
-def test_dask_path_gives_the_same_results_as_local(tmp_path):
-    """Dask on loopback stores the same rows as the local pool; a job past its deadline is time_limit."""
-    distributed = pytest.importorskip("dask.distributed")
-    suite = load_suite(str(write_suite(tmp_path, SMALL.replace('"greedy", "cpsat"', '"greedy"'))))
-    run_suite(suite, tmp_path / "local", workers=2, progress=False)
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
-                                  dashboard_address=None, host="127.0.0.1", protocol="tcp") as cluster:
-        assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
-        assert main(["bench", str(suite.path), "-o", str(tmp_path / "dask"), "--quiet",
-                     "--scheduler", cluster.scheduler_address]) == 0
-        napping = write_suite(tmp_path, 'methods = ["bench_methods:nap"]\ntime_limit = 0.2\ngrace = 0.2\n'
-                                        '[[instances]]\nM = 2\nK = 2\nN = 1', "nap.toml")
-        assert main(["bench", str(napping), "-o", str(tmp_path / "nap"), "--quiet",
-                     "--scheduler", cluster.scheduler_address]) == 0
-    [nap] = rows_of(tmp_path / "nap")
-    assert nap["status"] == "time_limit" and "abandoned" in nap["reason"]
-
-    def essence(rows):
-        return sorted((r["key"], r["status"], r["objective"], r["routes"], r["valid"]) for r in rows)
-
-    local, dask = rows_of(tmp_path / "local"), rows_of(tmp_path / "dask")
-    assert len(local) == len(suite.jobs) == 5
-    assert essence(local) == essence(dask)
-    assert all(r["workers"] is None for r in dask)
-
-
-def test_existing_results_need_resume(tmp_path, capsys):
-    """Running into a directory that holds results without --resume is a one-line error, exit 2."""
-    suite = write_suite(tmp_path, SMALL.replace('"greedy", "cpsat"', '"greedy"'))
-    out = tmp_path / "res"
-    assert main(["bench", str(suite), "-o", str(out), "--quiet"]) == 0
-    capsys.readouterr()
-    assert main(["bench", str(suite), "-o", str(out), "--quiet"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert "--resume" in err and len(err.splitlines()) == 1
-
-
-def test_unknown_suite_name_lists_builtins(capsys):
-    """A suite that is neither built in nor a file is a one-line error listing the built-ins."""
-    assert main(["bench", "no-such-suite", "--quiet"]) == 2
-    err = capsys.readouterr().err
-    assert "quick" in err and "paper-n" in err and len(err.strip().splitlines()) == 1
-
-
-def test_progress_bar_counts_and_eta():
-    """The progress bar prints count, percentage and an ETA; errors and time limits are tallied."""
-    import io
-
-    from sarcover.benchmarks.harness import Progress
-
-    stream = io.StringIO()
-    bar = Progress(4, "bench t", stream=stream)
-    for status in ("feasible", "error", "time_limit", "optimal"):
-        bar.update(status)
-    last = stream.getvalue().strip().splitlines()[-1]
-    assert "4/4" in last and "100%" in last and "ETA 0:00" in last and "1 error" in last and "1 time_limit" in last
-
-
 def test_methods_subset_then_rest_with_resume(tmp_path, capsys):
     """--methods runs only those of a suite's methods; a later --resume of the whole suite runs the rest."""
     suite = write_suite(tmp_path, SMALL)
@@ -248,8 +92,7 @@ def test_methods_subset_then_rest_with_resume(tmp_path, capsys):
 
 
 def test_ctrl_c_in_a_worker_stops_the_run_without_storing_its_job(tmp_path, capsys):
-    """A worker killed by SIGINT means the user pressed Ctrl-C: exit 130 and the job is not stored
-    as an error (so --resume runs it again)."""
+    """A worker killed by SIGINT (Ctrl-C) exits 130 without storing its job, so --resume runs it again."""
     body = 'methods = ["bench_methods:interrupted"]\ntime_limit = 5\n[[instances]]\nM = 2\nK = 2\nN = 1\nruns = 1\n'
     suite = write_suite(tmp_path, body)
     out = tmp_path / "res"
@@ -259,9 +102,7 @@ def test_ctrl_c_in_a_worker_stops_the_run_without_storing_its_job(tmp_path, caps
 
 
 def test_ctrl_c_records_the_part_of_the_run_that_was_stored(tmp_path):
-    """A run stopped by Ctrl-C after some jobs still appends its record to runs.jsonl (marked
-    interrupted, with the jobs it stored), and the report's "how it was run" shows it as stopped;
-    a run stopped before storing anything leaves no record."""
+    """A run stopped by Ctrl-C after storing jobs leaves an interrupted runs.jsonl record; one storing none, none."""
     from sarcover.reports.reference import _walls, write_reference
 
     body = ('methods = ["greedy", "bench_methods:interrupted"]\ntime_limit = 5\n'
@@ -280,8 +121,7 @@ def test_ctrl_c_records_the_part_of_the_run_that_was_stored(tmp_path):
 
 
 def test_suite_with_jit_methods_compiles_before_the_workers_start(tmp_path):
-    """The harness warms up in the parent (the workers fork from it) and says so on its stream;
-    a suite without numba methods does not."""
+    """A suite with numba methods compiles in the parent before the workers fork and says so; one without does not."""
     import io
 
     jit = write_suite(tmp_path, SMALL.replace('["greedy", "cpsat"]', '["greedy", "adpc-pso"]'), "jit.toml")
@@ -296,9 +136,7 @@ def test_suite_with_jit_methods_compiles_before_the_workers_start(tmp_path):
 
 
 def test_own_folder_of_instance_files_gives_share_proven_and_certified_gaps(tmp_path):
-    """The README's recipe for instance files of one's own: a suite naming a folder of instance
-    files (no published optima next to them). The report counts what bp proves per
-    size and bounds the gap of the runs it did not prove by their certified bound."""
+    """A suite over a folder of one's own files: the report gives bp's share proven and certified gaps of the rest."""
     import shutil
 
     from sarcover.benchmarks.catalog import TOP_DIR
@@ -324,3 +162,55 @@ def test_own_folder_of_instance_files_gives_share_proven_and_certified_gaps(tmp_
     methods = pd.read_csv(out / "report" / "methods.csv", index_col=0)
     assert methods.loc["bp", "gap_ub_n"] == 1
     assert methods.loc["bp", "gap_ub_max"] == pytest.approx((sar["bound"] - sar["objective"]) / sar["bound"])
+
+
+CRASHING = 'methods = ["greedy", "bench_methods:crash"]\n[[instances]]\nM = 3\nK = 2\nN = 1\n'
+
+
+def test_strict_exits_1_when_a_job_of_the_suite_ended_in_error(tmp_path, capsys):
+    """bench --strict exits 1 when a job of the suite (this run or stored) ended in error, 0 without errors."""
+    suite = write_suite(tmp_path, CRASHING)
+    assert main(["bench", str(suite), "-o", str(tmp_path / "a"), "--quiet"]) == 0
+    assert main(["bench", str(suite), "-o", str(tmp_path / "b"), "--quiet", "--strict"]) == 1
+    assert "1 job of the suite ended in error" in capsys.readouterr().err
+    assert main(["bench", str(suite), "-o", str(tmp_path / "b"), "--quiet", "--strict", "--resume"]) == 1
+    clean = write_suite(tmp_path, CRASHING.replace(', "bench_methods:crash"', ""), "clean.toml")
+    assert main(["bench", str(clean), "-o", str(tmp_path / "c"), "--quiet", "--strict"]) == 0
+
+
+def test_verbosity_flags_set_what_the_sarcover_loggers_print(tmp_path, capsys):
+    """The suite header by default, one line per job with -v, nothing with -q, before or after the subcommand."""
+    suite = write_suite(tmp_path, CRASHING)
+    assert main(["bench", str(suite), "-o", str(tmp_path / "d")]) == 0
+    err = capsys.readouterr().err
+    assert "suite s: 2 jobs" in err and "greedy|0: feasible" not in err
+    assert main(["-v", "bench", str(suite), "-o", str(tmp_path / "v")]) == 0
+    err = capsys.readouterr().err
+    assert "greedy|0: feasible in" in err and "crash|0: error in" in err and "RuntimeError: boom" in err
+    assert main(["bench", str(suite), "-o", str(tmp_path / "v2"), "-v"]) == 0
+    assert "greedy|0: feasible in" in capsys.readouterr().err
+    assert main(["bench", str(suite), "-o", str(tmp_path / "q"), "-q"]) == 0
+    assert capsys.readouterr().err == ""
+
+
+def test_run_records_carry_the_code_version_and_settings(tmp_path):
+    """Each runs.jsonl record names the code version and every method's time limits and parameters."""
+    from sarcover.benchmarks.provenance import code_version
+
+    suite = write_suite(tmp_path, SMALL.replace("time_limit = 10", "time_limit = 10\n[method.cpsat]\ntime_limit = 3"))
+    run_suite(load_suite(str(suite)), tmp_path / "r", workers=2, progress=False)
+    [record] = [json.loads(line) for line in (tmp_path / "r" / "runs.jsonl").read_text().splitlines()]
+    assert record["versions"]["sarcover"] == code_version()
+    assert record["settings"] == {"greedy": {"time_limit": [10], "params": {}},
+                                  "cpsat": {"time_limit": [3], "params": {}}}
+
+
+def test_a_failed_jobs_row_holds_its_whole_traceback(tmp_path):
+    """A method that raises leaves an error row with its whole traceback, registry frame to raising line."""
+    suite = write_suite(tmp_path, CRASHING)
+    run_suite(load_suite(str(suite)), tmp_path / "r", workers=1, progress=False)
+    [row] = [r for r in rows_of(tmp_path / "r") if r["status"] == "error"]
+    tb = row["info"]["traceback"]
+    assert tb[0].startswith("Traceback") and tb[-1] == "RuntimeError: boom"
+    assert any("registry.py" in line and "run_method" in line for line in tb)
+    assert any("bench_methods.py" in line and "crash" in line for line in tb)

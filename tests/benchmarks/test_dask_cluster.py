@@ -1,8 +1,9 @@
 """A real multi-process Dask cluster: `dask scheduler` and `dask worker --nworkers 2` as separate
 processes, suites through `sarcover bench --scheduler`, worker processes killed mid-job.
 
-A job whose worker dies is rerun by Dask on a live worker (the nanny restarts the dead one), so
-the suite ends with exactly one row per job, none lost; a job that kills every worker it runs on
+Each job runs in a child process of its Dask worker. A job whose Dask worker process dies (and
+its child with it) is rerun by Dask on a live worker (the nanny restarts the dead one), so the
+suite ends with exactly one row per job, none lost; a job that kills every worker it runs on
 becomes an `error` row once Dask gives up on it (README, "On a Dask cluster")."""
 
 import json
@@ -17,7 +18,7 @@ import pytest
 
 from sarcover.formulations.records import read_rows
 
-TESTS = Path(__file__).resolve().parent
+TESTS = Path(__file__).resolve().parents[1]  # tests/: bench_methods.py is there
 DASK = Path(sys.executable).with_name("dask")
 JOBS = 6
 
@@ -115,14 +116,21 @@ def _rows(folder):
     return rows
 
 
+def _parent(pid: int) -> int:
+    """The parent process of ``pid`` (Linux /proc)."""
+    stat = Path(f"/proc/{pid}/stat").read_text()
+    return int(stat.rsplit(")", 1)[1].split()[1])
+
+
 def test_killing_a_worker_mid_job_loses_no_job_and_stores_one_row_each(cluster, tmp_path):
+    """A Dask worker SIGKILLed mid-job: Dask reruns its job elsewhere, one row per job, the victim's from the rerun."""
     address, env, marks = cluster
     bench = _bench(tmp_path, env, address, f'name = "dask-kill"\nmethods = ["bench_methods:marked"]\n'
                    f'time_limit = 60\n[[instances]]\nM = 2\nK = 2\nN = 1\nruns = {JOBS}\ne_max = 20000\n')
     try:
         first = _wait_for(lambda: sorted(marks.iterdir(), key=lambda p: p.stat().st_mtime), 90, "a job to start")[0]
-        victim_job, victim_pid = first.name.rsplit(".", 1)
-        os.kill(int(victim_pid), signal.SIGKILL)  # a worker process dies in the middle of its job
+        victim_job, victim_pid = first.name.rsplit(".", 1)  # the pid of the job's child process
+        os.kill(_parent(int(victim_pid)), signal.SIGKILL)  # its Dask worker dies in the middle of the job
     finally:
         _finish(bench, tmp_path, marks)
     rows = _rows(tmp_path / "res")
@@ -134,10 +142,7 @@ def test_killing_a_worker_mid_job_loses_no_job_and_stores_one_row_each(cluster, 
 
 
 def test_a_job_that_kills_every_worker_becomes_an_error_row(cluster, tmp_path):
-    """Dask retries a job whose worker died up to allowed-failures times (lowered to 0 here to keep
-    the test short), then gives up: the harness stores an error row naming KilledWorker, one per
-    job. (Only such jobs run here: at 0 allowed failures a job queued behind one on the same
-    worker would be given up too.)"""
+    """A job that kills every worker it runs on becomes one error row naming KilledWorker once Dask gives up."""
     from dask.distributed import Client
 
     address, env, marks = cluster
@@ -149,7 +154,7 @@ def test_a_job_that_kills_every_worker_becomes_an_error_row(cluster, tmp_path):
     with Client(address, timeout="30s") as client:
         before = client.run_on_scheduler(set_allowed_failures, 0)
         try:
-            _finish(_bench(tmp_path, env, address, 'name = "dask-die"\nmethods = ["bench_methods:die"]\n'
+            _finish(_bench(tmp_path, env, address, 'name = "dask-die"\nmethods = ["bench_methods:kill_parent"]\n'
                            'time_limit = 30\n[[instances]]\nM = 2\nK = 2\nN = 1\nruns = 2\n'),
                     tmp_path, marks)
         finally:

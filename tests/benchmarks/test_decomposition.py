@@ -34,10 +34,7 @@ def small_rows(tmp_path_factory):
 
 
 def test_losses_sum_to_the_gap_and_have_their_signs(small_rows):
-    """For every row: the method's plan passes the verifier and has the row's objective;
-    clustering + cross-cluster + routing = OPT − objective exactly; OPT|C <= OPT; clustering and
-    routing loss >= 0; the cross-cluster part is 0 when the plan stays inside its clusters, and
-    then the routing loss is OPT|C − objective."""
+    """Verified plans; clustering + cross-cluster + routing = OPT - objective exactly, each part with its sign."""
     cases, rows, _ = small_rows
     by_name = {c.name: c for c in cases}
     assert len(rows) == 3 * len(METHODS) * 2
@@ -82,8 +79,7 @@ def test_opt_c_of_the_rows_is_brute_force(small_rows):
 
 
 def test_plans_inside_their_clusters_lose_nothing_to_cross_moves():
-    """Without the refill a plan mostly stays inside its clusters; those plans never beat OPT|C
-    (brute force), so their routing loss is >= 0 without a cross-cluster part."""
+    """A plan made inside its clusters (no refill) never beats OPT|C by brute force: routing loss >= 0."""
     checked = 0
     for s in range(6):
         inst = to_top(generate(3, 2, 2, seed=s, e_max=4000.0))
@@ -100,6 +96,7 @@ def test_plans_inside_their_clusters_lose_nothing_to_cross_moves():
 
 
 def test_plan_clusters_moves_visited_nodes_to_their_route():
+    """plan_clusters moves each visited node to its route's cluster and leaves unvisited nodes where they were."""
     clusters = [[0, 1, 2], [3, 4], []]
     plan = Plan.of([[0, 3], [4], [1]])
     assert plan_clusters(clusters, plan) == [[0, 2, 3], [4], [1]]
@@ -107,8 +104,7 @@ def test_plan_clusters_moves_visited_nodes_to_their_route():
 
 
 def test_resume_skips_stored_rows_and_survives_a_torn_line(small_rows, tmp_path):
-    """A second run adds nothing; after a torn last line the run completes the missing rows, and
-    the stored OPT|C values are reused (no new solve for a clustering already in the file)."""
+    """A rerun adds nothing; after a torn last line it completes the missing rows, reusing stored OPT|C values."""
     cases, rows, path = small_rows
     again = decompose(cases, path, seeds=(0, 1), stream=None)
     assert len(again) == len(rows)
@@ -127,8 +123,7 @@ def test_resume_skips_stored_rows_and_survives_a_torn_line(small_rows, tmp_path)
 
 
 def test_workers_give_the_rows_of_the_serial_run(small_rows, tmp_path):
-    """Two forked workers write the same rows as one process (order aside), row by row with
-    progress, and a second parallel run adds nothing."""
+    """Two pool workers write the rows of one worker (order aside), with progress; a rerun adds nothing."""
     cases, rows, _ = small_rows
     err = io.StringIO()
     par = decompose(cases, tmp_path / "par.jsonl", seeds=(0, 1), workers=2, stream=err)
@@ -143,8 +138,7 @@ def test_workers_give_the_rows_of_the_serial_run(small_rows, tmp_path):
 
 
 def test_cases_from_a_results_directory(tmp_path):
-    """Cases come from a harness results directory: OPT from the proven exact row, the plan the
-    oracle clustering starts from verified; an instance without exact rows is skipped."""
+    """Cases from a harness results folder: OPT from the proven exact row, the oracle's plan verified."""
     from sarcover.benchmarks.harness import run_suite
     from sarcover.benchmarks.suite import load_suite
 
@@ -176,3 +170,39 @@ def test_unproven_opt_is_flagged(tmp_path):
     assert r["clustering_loss"] + r["cross_cluster"] + r["routing_loss"] == r["gap"]
     assert np.isclose(r["clustering_loss"], case.opt + 3 - r["opt_c"])
 
+
+
+def test_a_killed_or_hung_worker_becomes_a_row_and_the_run_goes_on(tmp_path, monkeypatch):
+    """A decomposition job whose process dies or hangs becomes an error or time_limit row; the others still run."""
+    import os
+    import signal
+    import time
+
+    import sarcover.benchmarks.decomposition as decomposition
+
+    inst = to_top(generate(5, 2, 2, seed=4))
+    cases = cases_from_instances([("a", inst, {}), ("b", inst, {})], opt_method="milp", time_limit=60, stream=None)
+    real = decomposition._run_paper_method
+
+    def faulty(method, instance, seed, time_limit):  # forked workers inherit it
+        if method == "dpc-pso" and seed == 0:
+            os.kill(os.getpid(), signal.SIGKILL)
+        if method == "dpc-pso" and seed == 1:
+            time.sleep(600)
+        return real(method, instance, seed, time_limit)
+
+    monkeypatch.setattr(decomposition, "_run_paper_method", faulty)
+    path = tmp_path / "rows.jsonl"
+    t0 = time.monotonic()
+    rows = decompose(cases, path, methods=("adpc-pso", "dpc-pso"), seeds=(0, 1), time_limit=1.0,
+                     clustered_time_limit=1.0, grace=1.0, workers=2, stream=None)
+    assert time.monotonic() - t0 < 60
+    by = {row_key(r): r for r in rows}
+    assert len(rows) == len(by) == 8
+    for name in ("a", "b"):
+        assert by[f"{name}|dpc-pso|0"]["status"] == "error" and "SIGKILL" in by[f"{name}|dpc-pso|0"]["reason"]
+        assert by[f"{name}|dpc-pso|1"]["status"] == "time_limit" and "killed after" in by[f"{name}|dpc-pso|1"]["reason"]
+        for s in (0, 1):
+            r = by[f"{name}|adpc-pso|{s}"]
+            assert r["clustering_loss"] + r["cross_cluster"] + r["routing_loss"] == r["gap"]
+    assert len(decompose(cases, path, methods=("adpc-pso", "dpc-pso"), seeds=(0, 1), stream=None)) == 8
