@@ -158,10 +158,11 @@ def verify_plan(instance, plan, *, results: str | Path | None = None):
 
 def run_suite(suite, out_dir: str | Path | None = None, *, workers: int | None = None, resume: bool = False,
               scheduler: str | None = None, runs: int | None = None, methods: list[str] | None = None,
-              progress: bool = True) -> dict:
+              progress: bool = True, security=None) -> dict:
     """Run a benchmark suite (a built-in name such as ``"quick"``, a suite TOML file, or a loaded
     suite) into ``out_dir`` (default ``results/<suite>``), one verified row per job; locally on
-    ``workers`` processes, or on the Dask scheduler at ``scheduler`` (``"tcp://host:8786"``).
+    ``workers`` processes, or on the Dask scheduler at ``scheduler`` (``"tcp://host:8786"``, or
+    ``"tls://host:8786"`` with ``security``, a :class:`distributed.security.Security`).
     Returns a summary (jobs, runs, counts by status, the results file)."""
     from sarcover.benchmarks.harness import run_suite as _run_suite
     from sarcover.benchmarks.suite import Suite, load_suite
@@ -169,7 +170,8 @@ def run_suite(suite, out_dir: str | Path | None = None, *, workers: int | None =
     if not isinstance(suite, Suite):
         suite = load_suite(str(suite), runs=runs, methods=methods)
     out = Path(out_dir) if out_dir is not None else Path("results") / suite.name
-    return _run_suite(suite, out, workers=workers, resume=resume, scheduler=scheduler, progress=progress)
+    return _run_suite(suite, out, workers=workers, resume=resume, scheduler=scheduler, security=security,
+                      progress=progress)
 
 
 def load_results(results_dir: str | Path):

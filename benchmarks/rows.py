@@ -95,6 +95,8 @@ def run_one(job: dict) -> dict:
             rec["info"]["traceback"] = run.info["traceback"]
         row.update(rec)
         row["threads"] = run.info.get("threads")
+        if isinstance(run.info.get("params"), dict):  # what the method ran with, every default filled in
+            row["params"] = run.info["params"]
     except BaseException as exc:  # noqa: BLE001 - a job must never take the harness down
         if isinstance(exc, KeyboardInterrupt):
             raise

@@ -17,6 +17,7 @@ from bench_suites import SMALL, rows_of, write_suite
 def test_small_suite_end_to_end_cli(tmp_path, capsys):
     """bench stores one verified row per job with provenance; report writes md, html, png, csv."""
     from sarcover.benchmarks.provenance import code_version
+    from sarcover.benchmarks.registry import get_method
 
     suite = write_suite(tmp_path, SMALL)
     out = tmp_path / "res"
@@ -30,7 +31,8 @@ def test_small_suite_end_to_end_cli(tmp_path, capsys):
             assert r["objective"] == pytest.approx(r["coverage"] * r["M"] * r["K"])
         assert r["energy_used"] <= r["e_max"] * r["n_vehicles"] * (1 + 1e-9)
         assert r["versions"]["numpy"] and r["host"] and r["schema"] == SCHEMA_VERSION and r["workers"] == 2
-        assert r["versions"]["sarcover"] == code_version() and r["params"] == {}
+        assert r["versions"]["sarcover"] == code_version()
+        assert r["params"] == get_method(r["method"]).resolve(None)  # the fully resolved defaults
         assert list(r) == list(FIELDS)  # the one schema, in its order
         assert (r["termination"], r["solution"]) in (("completed", "feasible"), ("optimal", "optimal"))
         assert 0 < r["cpu_s"] <= r["wall_s"] + 0.05  # the job thread's CPU time, within its wall time
@@ -196,13 +198,14 @@ def test_verbosity_flags_set_what_the_sarcover_loggers_print(tmp_path, capsys):
 def test_run_records_carry_the_code_version_and_settings(tmp_path):
     """Each runs.jsonl record names the code version and every method's time limits and parameters."""
     from sarcover.benchmarks.provenance import code_version
+    from sarcover.benchmarks.registry import get_method
 
     suite = write_suite(tmp_path, SMALL.replace("time_limit = 10", "time_limit = 10\n[method.cpsat]\ntime_limit = 3"))
     run_suite(load_suite(str(suite)), tmp_path / "r", workers=2, progress=False)
     [record] = [json.loads(line) for line in (tmp_path / "r" / "runs.jsonl").read_text().splitlines()]
     assert record["versions"]["sarcover"] == code_version()
     assert record["settings"] == {"greedy": {"time_limit": [10], "params": {}},
-                                  "cpsat": {"time_limit": [3], "params": {}}}
+                                  "cpsat": {"time_limit": [3], "params": get_method("cpsat").resolve(None)}}
 
 
 def test_a_failed_jobs_row_holds_its_whole_traceback(tmp_path):

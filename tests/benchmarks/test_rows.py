@@ -1,6 +1,7 @@
 """Rows of jobs (benchmarks/rows.py): one row per job in the schema's order, never an exception."""
 
 from sarcover.benchmarks.provenance import code_version
+from sarcover.benchmarks.registry import get_method
 from sarcover.benchmarks.rows import failed_row, run_one
 from sarcover.formulations.records import FIELDS
 
@@ -14,19 +15,21 @@ def job(method: str = "greedy", **extra) -> dict:
 
 
 def test_a_row_carries_the_jobs_parameters_and_the_code_version():
-    """A row holds the job's parameters ({} without) and the commit-labelled code version, in the schema's order."""
-    row = run_one(job(params={"iterations": 300, "population": 30}))
+    """A row holds the method's resolved parameters (the job's, every default filled in) and the
+    commit-labelled code version, in the schema's order."""
+    row = run_one(job("adpc-pso", params={"iterations": 3, "population": 5}))
     assert row["status"] in ("feasible", "optimal") and list(row) == list(FIELDS)
-    assert row["params"] == {"iterations": 300, "population": 30}
+    assert row["params"] == get_method("adpc-pso").resolve({"iterations": 3, "population": 5})
+    assert row["params"]["iterations"] == 3 and "xi" in row["params"]
     assert row["versions"]["sarcover"] == code_version()
-    assert run_one(job())["params"] == {}
+    assert run_one(job())["params"] == {}  # greedy takes none
 
 
 def test_a_method_name_the_registry_does_not_know_is_an_error_row():
-    """An unknown method (a variant name the registry does not know yet) is an error row under the job's name."""
-    row = run_one(job("adpc-pso[iterations=300]"))
+    """An unknown method (also as a variant name) is an error row under the job's name."""
+    row = run_one(job("no-such-method[iterations=300]"))
     assert row["status"] == "error" and "unknown method" in row["reason"]
-    assert row["method"] == "adpc-pso[iterations=300]"
+    assert row["method"] == "no-such-method[iterations=300]"
 
 
 def test_a_killed_jobs_row_says_why_and_how_long():

@@ -7,7 +7,7 @@ import os
 import subprocess
 import sys
 
-from sarcover.benchmarks.harness import run_one
+from sarcover.benchmarks.rows import run_one
 
 SCRIPT = """
 import sys
