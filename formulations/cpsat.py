@@ -70,7 +70,7 @@ import numpy as np
 from ortools.sat.python import cp_model
 
 from sarcover.formulations.errors import SarcoverError
-from sarcover.formulations.history import History
+from sarcover.formulations.history import History, stop_reason_of
 from sarcover.formulations.instance import TOPInstance, precheck
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
@@ -406,6 +406,7 @@ def solve_cpsat(
             plan, prize = best["plan"], best["prize"]
             reason = (reason + "; " if reason else "") + "returned the best verified plan seen during the search"
         info["history"] = hist.finish(prize, bound)
+        info["stop_reason"] = stop_reason_of(termination)
         return Result("cpsat", termination, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
                       reason=reason, info=info)
 

@@ -1,20 +1,57 @@
-"""Anytime history of an exact method: incumbent and bound against time.
+"""Anytime history of a method: incumbent and bound against time, and why the run stopped.
 
 ``Result.info["history"]`` is a list of ``[t, incumbent, bound]``: ``t`` seconds since the method
 was called, ``incumbent`` the best verified objective found so far (None before the first plan)
-and ``bound`` the best proven upper bound so far (None before the first one), both in the
-objective's units. A point is appended whenever either improves, and a last point at the end
-holds exactly the method's final objective and bound. Plain floats and None only, so a result
-row stays JSON; thinned to at most :data:`MAX_POINTS` points (first and last always kept).
+and ``bound`` the best proven upper bound so far (None before the first one, and always None for
+a heuristic), both in the objective's units. A point is appended whenever either improves, and a
+last point at the end holds exactly the method's final objective and bound. Plain floats and None
+only, so a result row stays JSON; thinned to at most :data:`MAX_POINTS` points (first and last
+always kept). Every registered method records one (greedy a single point); a heuristic's
+incumbent is the prize its returned plan would count at that moment (after its own repair).
+
+``Result.info["stop_reason"]`` says why the run ended, one of :class:`StopReason`.
 """
 
 from __future__ import annotations
 
 import math
 import time
+from enum import Enum
+
+from sarcover.formulations.result import Termination
 
 MAX_POINTS = 200
 _EPS = 1e-9
+
+
+class StopReason(str, Enum):
+    """Why a run ended (``info["stop_reason"]``); a run that ends before its time limit says which.
+
+    PROOF: an exact method proved its plan optimal (or that none exists). TIME_LIMIT: the time limit
+    stopped it. ITERATION_LIMIT: its own iteration or solution count, the reproducible stop (the same
+    seed gives the same plan). CONVERGED: its own no-improvement criterion. COMPLETED: it ran a fixed
+    schedule with nothing left to search (a construction such as greedy, or an exact solver whose
+    proof holds only for a scaled model).
+    """
+
+    PROOF = "proof"
+    TIME_LIMIT = "time_limit"
+    ITERATION_LIMIT = "iteration_limit"
+    CONVERGED = "converged"
+    COMPLETED = "completed"
+
+    def __str__(self) -> str:
+        return self.value
+
+
+def stop_reason_of(termination: Termination) -> str:
+    """The stop reason an exact method's termination implies (an error ends it too: "completed")."""
+    termination = Termination(termination)
+    if termination in (Termination.OPTIMAL, Termination.INFEASIBLE):
+        return StopReason.PROOF.value
+    if termination is Termination.TIME_LIMIT:
+        return StopReason.TIME_LIMIT.value
+    return StopReason.COMPLETED.value
 
 
 def thin(points: list, max_points: int = MAX_POINTS) -> list:

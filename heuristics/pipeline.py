@@ -16,9 +16,11 @@ keeps the clusters (``clusters``) and, per route, the nodes repair or refill too
 its cluster (``outside_cluster``).
 
 Runs are seeded (``numpy.random.default_rng(seed)``; KMeans gets ``random_state=seed``) and
-stopped by iteration counts, so the same seed gives the same plan. ``time_limit`` is a safety
-net only: when it expires the routers stop iterating and ``info["stopped_by_time"]`` is set, and
-such a run is no longer reproducible.
+stopped by iteration counts, so the same seed gives the same plan (``info["stop_reason"]`` is
+``"iteration_limit"``). They also stop at ``time_limit``: when it expires the routers stop
+iterating, ``info["stopped_by_time"]`` is set and the stop reason is ``"time_limit"``; such a run
+is no longer reproducible. The anytime history (``info["history"]``) is one point: the plan
+exists only once the energy repair has made the tours feasible, and its prize is the plan's.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from typing import Callable
 
 import numpy as np
 
+from sarcover.formulations.history import History, StopReason
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
@@ -134,6 +137,7 @@ def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info
         tours = batch.routes(tours, best)
     tours = [two_opt(D, t, 0, end).tolist() for t in tours]
     info["stopped_by_time"] = bool(deadline is not None and time.perf_counter() > deadline)
+    info["stop_reason"] = (StopReason.TIME_LIMIT if info["stopped_by_time"] else StopReason.ITERATION_LIMIT).value
     t2, c2 = time.perf_counter(), time.thread_time()
 
     repairer = Repairer(instance, D=D)
@@ -141,6 +145,7 @@ def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info
         routes = repairer.repair(tours, reinsert=reinsert)
     except RepairFailed as exc:
         info.update(repairer.stats)
+        info["history"] = History(t0).finish(None, None)
         return Result(name, Termination.COMPLETED, reason=str(exc), runtime_s=time.perf_counter() - t0, info=info)
     t3, c3 = time.perf_counter(), time.thread_time()
     info.update(repairer.stats)
@@ -151,7 +156,9 @@ def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info
     outside = outside_clusters(routes, clusters)
     info["outside_cluster"] = outside
     info["n_outside_cluster"] = sum(len(o) for o in outside)
-    return Result(name, Termination.COMPLETED, plan=Plan.of(routes), runtime_s=time.perf_counter() - t0, info=info)
+    plan = Plan.of(routes)
+    info["history"] = History(t0).finish(float(sum(instance.prizes[v] for v in plan.visited)), None)
+    return Result(name, Termination.COMPLETED, plan=plan, runtime_s=time.perf_counter() - t0, info=info)
 
 
 def route_clusters(
@@ -203,6 +210,8 @@ def cluster_then_route(
     rng = np.random.default_rng(seed)
     info: dict = {"clusterer": clusterer, "router": router}
     if not instance.reachable().any():
+        info["stop_reason"] = StopReason.COMPLETED.value
+        info["history"] = History(t0).finish(None if instance.groups else 0.0, None)
         if instance.groups:
             return Result(name, Termination.COMPLETED, reason="no viewpoint is reachable within E_max",
                           runtime_s=time.perf_counter() - t0, info=info)
