@@ -405,7 +405,7 @@ def solve_cpsat(
             # a truly feasible plan seen during the search beats the final one (e.g. a repaired one)
             plan, prize = best["plan"], best["prize"]
             reason = (reason + "; " if reason else "") + "returned the best verified plan seen during the search"
-        info["history"] = hist.finish(prize, bound)
+        hist.record(info, prize, bound)
         info["stop_reason"] = stop_reason_of(termination)
         return Result("cpsat", termination, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
                       reason=reason, info=info)

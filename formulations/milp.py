@@ -433,7 +433,7 @@ def solve_milp(
         return None if deadline is None else max(deadline - time.perf_counter(), 0.0)
 
     def done(termination, plan=None, bound=None, reason=""):
-        info["history"] = hist.finish(verify(instance, plan).prize if plan is not None else None, bound)
+        hist.record(info, verify(instance, plan).prize if plan is not None else None, bound)
         info["stop_reason"] = stop_reason_of(termination)
         info["runtime_model_s"] = round(time.perf_counter() - t0, 4)
         return Result(METHOD, termination, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,

@@ -38,10 +38,10 @@ def greedy(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = N
     missing = repairer.cover(rs, reach)
     if missing is not None:
         what = "target" if instance.kind == "sar" else "group"
-        info["history"] = hist.finish(None, None)
+        hist.record(info, None, None)
         return Result("greedy", Termination.COMPLETED, reason=f"greedy could not fit a viewpoint of {what} {missing}",
                       runtime_s=time.perf_counter() - t0, info=info)
     repairer.fill(rs, reach)
     plan = Plan.of(rs.node_routes())
-    info["history"] = hist.finish(float(sum(instance.prizes[v] for v in plan.visited)), None)
+    hist.record(info, float(sum(instance.prizes[v] for v in plan.visited)), None)
     return Result("greedy", Termination.COMPLETED, plan=plan, runtime_s=time.perf_counter() - t0, info=info)

@@ -91,15 +91,18 @@ def solve_routing(
     hist = History(t0) if own_history else history
     nodes = _useful_nodes(instance)
     k, n_veh = len(nodes), instance.n_vehicles
-    trivial = {"stopped_by": "trivial", "stop_reason": StopReason.COMPLETED.value}
+    def trivial(prize: float | None) -> dict:
+        info = {"stopped_by": "trivial", "stop_reason": StopReason.COMPLETED.value}
+        if own_history:
+            hist.record(info, prize, None)
+        return info
+
     if k == 0:
         if instance.groups:
             return Result("routing", Termination.COMPLETED, reason="no group node is reachable",
-                          runtime_s=time.perf_counter() - t0,
-                          info={**trivial, "history": hist.finish(None, None)} if own_history else trivial)
+                          runtime_s=time.perf_counter() - t0, info=trivial(None))
         return Result("routing", Termination.COMPLETED, plan=Plan.of([[] for _ in range(n_veh)]),
-                      runtime_s=time.perf_counter() - t0,
-                      info={**trivial, "history": hist.finish(0.0, None)} if own_history else trivial)
+                      runtime_s=time.perf_counter() - t0, info=trivial(0.0))
 
     # Groups: every group node v gets a "cover copy" at the same place. Disjunction {v, copy}
     # (at most one active, penalty prize_v if neither) keeps v's prize exact and forbids a
@@ -116,8 +119,7 @@ def solve_routing(
                 locs.append(k + len(copies))
         if not locs:
             return Result("routing", Termination.COMPLETED, reason=f"group {gi} has no reachable node",
-                          runtime_s=time.perf_counter() - t0,
-                          info={**trivial, "history": hist.finish(None, None)} if own_history else trivial)
+                          runtime_s=time.perf_counter() - t0, info=trivial(None))
         group_locs.append(locs)
     model_nodes = np.concatenate([nodes, np.asarray(copies, dtype=int)]).astype(int)  # model loc - 1 -> node id
     n_loc = len(model_nodes) + 2
@@ -214,8 +216,7 @@ def solve_routing(
 
     def done(termination, plan=None, reason=""):
         if own_history:
-            info["history"] = hist.finish(None if plan is None else float(sum(instance.prizes[v] for v in plan.visited)),
-                                          None)
+            hist.record(info, None if plan is None else float(sum(instance.prizes[v] for v in plan.visited)), None)
         return Result("routing", termination, plan=plan, reason=reason, runtime_s=time.perf_counter() - t0, info=info)
 
     if solution is None:
@@ -281,6 +282,6 @@ def routing(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 
             result.info["stop_reason"] = StopReason.TIME_LIMIT.value
     result.method = "routing"
     final = _prize(instance, result)
-    result.info["history"] = hist.finish(final if final >= 0 else None, None)
+    hist.record(result.info, final if final >= 0 else None, None)
     result.runtime_s = time.perf_counter() - t0
     return result

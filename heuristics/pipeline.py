@@ -122,11 +122,12 @@ def _check_clusters(instance: TOPInstance, clusters) -> list[np.ndarray]:
     return clusters
 
 
-def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info, t0, c0, t1, c1) -> Result:
+def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info, t0, c0, t1, c1, hist) -> Result:
     """Route each cluster (router + 2-opt), then repair; route i is cluster i's UAV.
 
     ``clusters`` are node ids; the routers and the repair work in solver indices (id + 1).
-    Times from t0 (call) and t1 (end of clustering) go into ``info``.
+    Times from t0 (call) and t1 (end of clustering) go into ``info``; ``hist`` (started at the
+    call) gets the plan's prize once the repair has made it.
     """
     D = instance.distance_matrix()
     end = instance.n_nodes + 1
@@ -145,7 +146,7 @@ def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info
         routes = repairer.repair(tours, reinsert=reinsert)
     except RepairFailed as exc:
         info.update(repairer.stats)
-        info["history"] = History(t0).finish(None, None)
+        hist.record(info, None, None)
         return Result(name, Termination.COMPLETED, reason=str(exc), runtime_s=time.perf_counter() - t0, info=info)
     t3, c3 = time.perf_counter(), time.thread_time()
     info.update(repairer.stats)
@@ -157,7 +158,7 @@ def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info
     info["outside_cluster"] = outside
     info["n_outside_cluster"] = sum(len(o) for o in outside)
     plan = Plan.of(routes)
-    info["history"] = History(t0).finish(float(sum(instance.prizes[v] for v in plan.visited)), None)
+    hist.record(info, float(sum(instance.prizes[v] for v in plan.visited)), None)
     return Result(name, Termination.COMPLETED, plan=plan, runtime_s=time.perf_counter() - t0, info=info)
 
 
@@ -179,13 +180,14 @@ def route_clusters(
     route, the nodes the repair or refill put there from outside its cluster.
     """
     t0, c0 = time.perf_counter(), time.thread_time()
+    hist = History(t0)
     clusters = _check_clusters(instance, clusters)
     clusters += [np.zeros(0, dtype=int) for _ in range(instance.n_vehicles - len(clusters))]
     deadline = None if time_limit is None else t0 + float(time_limit)
     info: dict = {"clusterer": "given", "router": router, "cluster_sizes": [int(c.size) for c in clusters],
                   "clusters": [c.tolist() for c in clusters]}
     return _route_stage(instance, clusters, router, np.random.default_rng(seed), deadline, reinsert,
-                        name or f"given-{router}", info, t0, c0, t0, c0)
+                        name or f"given-{router}", info, t0, c0, t0, c0, hist)
 
 
 def cluster_then_route(
@@ -205,13 +207,14 @@ def cluster_then_route(
     lists per route the nodes repair or refill took from outside that cluster.
     """
     t0, c0 = time.perf_counter(), time.thread_time()
+    hist = History(t0)
     name = name or f"{clusterer}-{router}"
     deadline = None if time_limit is None else t0 + float(time_limit)
     rng = np.random.default_rng(seed)
     info: dict = {"clusterer": clusterer, "router": router}
     if not instance.reachable().any():
         info["stop_reason"] = StopReason.COMPLETED.value
-        info["history"] = History(t0).finish(None if instance.groups else 0.0, None)
+        hist.record(info, None if instance.groups else 0.0, None)
         if instance.groups:
             return Result(name, Termination.COMPLETED, reason="no viewpoint is reachable within E_max",
                           runtime_s=time.perf_counter() - t0, info=info)
@@ -222,7 +225,7 @@ def cluster_then_route(
     info["cluster_sizes"] = [int(c.size) for c in clusters]
     info["clusters"] = [c.tolist() for c in clusters]
     t1, c1 = time.perf_counter(), time.thread_time()
-    return _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info, t0, c0, t1, c1)
+    return _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info, t0, c0, t1, c1, hist)
 
 
 def warm_up() -> None:

@@ -292,7 +292,7 @@ def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60
         if "stop_reason" not in info:
             info["stop_reason"] = (StopReason.TIME_LIMIT if timed else StopReason.ITERATION_LIMIT).value
         plan = None if routes is None else Plan.of(routes)
-        info["history"] = hist.finish(None if plan is None else _prize(instance, plan.routes), None)
+        hist.record(info, None if plan is None else _prize(instance, plan.routes), None)
         return Result("pyvrp", Termination.COMPLETED, plan=plan, reason=reason,
                       runtime_s=time.perf_counter() - t0, info=info)
 

@@ -21,3 +21,16 @@ def test_compact_models_say_proof_when_they_prove(method, line_instance):
     """milp and cpsat prove the line instance optimal and give "proof" as their stop reason."""
     res = run_method(method, line_instance, time_limit=20.0)
     assert res.status == "optimal" and res.info["stop_reason"] == StopReason.PROOF
+
+
+def test_record_keeps_one_cpu_time_per_kept_point():
+    """History.record writes the thinned history and the CPU time of each kept point, rising."""
+    from sarcover.formulations.history import MAX_POINTS, History
+
+    hist = History()
+    for z in range(3 * MAX_POINTS):
+        hist.update(incumbent=float(z))
+    info: dict = {}
+    hist.record(info, float(3 * MAX_POINTS), None)
+    assert len(info["history"]) == len(info["history_cpu"]) == MAX_POINTS
+    assert info["history_cpu"] == sorted(info["history_cpu"]) and info["history"][-1][1] == 3 * MAX_POINTS

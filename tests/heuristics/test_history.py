@@ -28,6 +28,8 @@ def test_history_is_well_formed_and_ends_at_the_verified_objective(method, insta
     assert times == sorted(times) and 0.0 <= times[0] and times[-1] <= res.runtime_s + 1e-3
     assert incs == sorted(incs)
     assert hist[-1][1] == res.objective
+    cpu = res.info["history_cpu"]
+    assert len(cpu) == len(hist) and cpu == sorted(cpu) and cpu[0] >= 0.0
 
 
 def test_greedy_is_one_point(instance):
