@@ -26,6 +26,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from sarcover.reports.convergence import write_convergence  # noqa: E402
 from sarcover.reports.decomposition import write_decomposition  # noqa: E402
 from sarcover.reports.optimum import optimum_section  # noqa: E402
 from sarcover.reports.plots import save_figure  # noqa: E402
@@ -286,6 +287,8 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
     if opt is not None:
         L += optimum_section(opt, out)
     L += _decomposition_section(root, out)
+    if (anytime := _load(root, "anytime")) is not None:  # gap over time; optima also from paper-opt's proofs
+        L += [write_convergence(anytime, [opt] if opt is not None else [], out)]
     L += _top_section(top, out)
     if top47 is not None:
         L += top_sets_section(top47, out)

@@ -1,0 +1,116 @@
+"""Gap over time (reports/convergence.py): step functions, primal integral, times to a mean gap."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from sarcover.reports.convergence import (
+    convergence_table,
+    first_time,
+    primal_integral,
+    proven_optima,
+    runs_table,
+    step_points,
+    write_convergence,
+)
+
+
+def row(method, history, objective, *, instance="i1", status="feasible", runtime=None, cpu=None, share=(1.0, 1.0),
+        K=3, limit=10.0):
+    """A result row as the harness writes it, with only the fields the report reads."""
+    info = {"history": history}
+    if cpu is not None:
+        info["history_cpu"] = cpu
+    return {"instance": instance, "method": method, "seed": 0, "status": status, "objective": objective,
+            "runtime_s": runtime if runtime is not None else (history[-1][0] if history else 0.0),
+            "time_limit": limit, "cpu_s": share[0], "wall_s": share[1], "info": info, "M": 20, "K": K, "N": 5,
+            "exact": method == "bp"}
+
+
+def test_step_function_by_hand():
+    """Incumbents 5 at 1 s and 8 at 3 s against an optimum of 10: gap 1, then 0.5, then 0.2."""
+    t, g = step_points(row("x", [[1.0, 5.0, None], [3.0, 8.0, None]], 8.0), 10.0)
+    assert t.tolist() == [0.0, 1.0, 3.0] and g.tolist() == pytest.approx([1.0, 0.5, 0.2])
+
+
+def test_primal_integral_by_hand():
+    """Over [0, 10]: 1 s at gap 1, 2 s at 0.5, 7 s at 0.2 make 3.4 s."""
+    t, g = step_points(row("x", [[1.0, 5.0, None], [3.0, 8.0, None]], 8.0), 10.0)
+    assert primal_integral(t, g, 10.0) == pytest.approx(3.4)
+    assert primal_integral(t, g, 2.0) == pytest.approx(1.5)  # the limit cuts the last step
+
+
+@pytest.mark.parametrize("history, objective, status", [
+    ([[0.5, None, None]], None, "no_plan"),  # no plan found
+    ([], None, "error"),  # a crashed or killed job
+    ([[0.5, 9.0, None]], 9.0, "error"),  # a plan the verifier rejected counts as none
+])
+def test_without_a_plan_the_gap_is_one_throughout(history, objective, status):
+    """No plan (none found, a crash, a rejected plan): gap 100 % over the whole limit."""
+    t, g = step_points(row("x", history, objective, status=status), 10.0)
+    assert g.tolist() == [1.0] and primal_integral(t, g, 10.0) == pytest.approx(10.0)
+
+
+def test_final_objective_closes_a_history_that_ends_lower():
+    """A row whose history ends below its verified objective gets the objective at its runtime."""
+    t, g = step_points(row("x", [[1.0, 5.0, None]], 10.0, runtime=4.0), 10.0)
+    assert t.tolist() == [0.0, 1.0, 4.0] and g[-1] == 0.0
+
+
+def test_cpu_clock_from_history_cpu_or_the_job_share():
+    """The CPU clock uses history_cpu where recorded, else wall times scaled by cpu_s / wall_s."""
+    rec = row("x", [[2.0, 5.0, None], [4.0, 10.0, None]], 10.0, cpu=[1.0, 1.5])
+    assert step_points(rec, 10.0, "cpu")[0].tolist() == [0.0, 1.0, 1.5]
+    est = row("bp", [[2.0, 5.0, None], [4.0, 10.0, None]], 10.0, share=(2.5, 10.0))
+    assert step_points(est, 10.0, "cpu")[0].tolist() == pytest.approx([0.0, 0.5, 1.0])
+
+
+def test_first_time_to_a_mean_gap():
+    """Two instances reaching the optimum at 2 s and 4 s: the mean gap is 0 from 4 s on, at most
+    50 % from 2 s on, and 5 % is never reached by a 3 s limit."""
+    rows = pd.DataFrame([row("x", [[2.0, 10.0, None]], 10.0, instance="a"),
+                         row("x", [[4.0, 10.0, None]], 10.0, instance="b")])
+    tab = convergence_table(runs_table(rows, pd.Series({"a": 10.0, "b": 10.0})))
+    r = tab.iloc[0]
+    assert r["t_gap0_wall_s"] == 4.0 and r["t_gap5_wall_s"] == 4.0
+    assert r["gap_at_1s"] == 1.0 and r["gap_at_10s"] == 0.0
+    assert r["primal_integral_wall_s"] == pytest.approx(3.0)  # (2 + 4) / 2
+    assert np.isnan(first_time(np.array([0.0, 4.0]), np.array([1.0, 0.0]), 0.05, 3.0))
+
+
+def test_proven_optima_disagreeing_is_an_error():
+    """Two 'optimal' rows with different objectives on one instance make the gaps meaningless."""
+    a = pd.DataFrame([{"instance": "i", "status": "optimal", "objective": 10.0},
+                      {"instance": "i", "status": "optimal", "objective": 11.0}])
+    with pytest.raises(ValueError, match="disagree"):
+        proven_optima(a)
+
+
+def test_write_convergence_end_to_end(tmp_path):
+    """Figures per setting, the CSVs, the best method at each time, and the instance without a
+    proven optimum named as left out."""
+    rows = pd.DataFrame([
+        row("greedy", [[0.005, 8.0, None]], 8.0, instance="a"),
+        row("pyvrp", [[0.05, 9.0, None], [2.0, 10.0, None]], 10.0, instance="a"),
+        row("bp", [[0.2, 9.0, 12.0], [5.0, 10.0, 10.0]], 10.0, instance="a", status="optimal"),
+        row("greedy", [[0.005, 7.0, None]], 7.0, instance="open"),
+        row("greedy", [[0.005, 20.0, None]], 20.0, instance="c", K=6),
+        row("bp", [[1.0, 20.0, 20.0]], 20.0, instance="c", K=6, status="optimal"),
+    ])
+    text = write_convergence(rows, [], tmp_path)
+    for name in ("anytime_m20_k3_n5.png", "anytime_m20_k6_n5.png", "anytime_table.csv", "anytime_curves.csv",
+                 "anytime_runs.csv"):
+        assert (tmp_path / name).stat().st_size > 0
+    assert "Left out (no proven optimum): open." in text
+    assert "0.01 s: greedy (20.0 %)" in text and "10 s: pyvrp, bp (0.0 %)" in text
+    tab = pd.read_csv(tmp_path / "anytime_table.csv")
+    k3 = tab[tab["setting"] == "M=20 K=3 N=5"].set_index("method")
+    assert k3.loc["pyvrp", "t_gap0_wall_s"] == 2.0 and k3.loc["bp", "t_gap0_wall_s"] == 5.0
+
+
+def test_files_without_a_grid_form_one_setting(tmp_path):
+    """Rows of TOP files (no M, K, N) are one setting named by their kind."""
+    rows = pd.DataFrame([{**row("bp", [[1.0, 5.0, 5.0]], 5.0, status="optimal"), "M": None, "K": None, "N": None,
+                          "kind": "top"}])
+    text = write_convergence(rows, [], tmp_path)
+    assert "### top (1 instances with a proven optimum)" in text and (tmp_path / "anytime_top.png").exists()
