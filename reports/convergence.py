@@ -20,7 +20,10 @@ optimum are left out and listed. Two clocks, both from the method's call: wall t
 (``info.history``) and CPU time (``info.history_cpu``, the process's CPU seconds at each point;
 on a machine shared with other work the clock that load does not inflate). A row without
 ``history_cpu`` (bp keeps its own history) gets its wall times scaled by the job's CPU share
-``cpu_s / wall_s`` (:func:`cpu_share`), an estimate; the table says how many runs that is.
+``cpu_s / wall_s`` (:func:`cpu_share`), an estimate; the table says how many runs that is. The
+time limit is on the wall clock, so on a loaded machine a run cut by it received fewer CPU seconds
+than the limit: on the CPU clock a value at time t is given only where every run of the method had
+either ended on its own (proof, iteration limit, construction) or received at least t CPU seconds.
 """
 
 from __future__ import annotations
@@ -34,12 +37,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from sarcover.formulations.history import stop_reason_of  # noqa: E402
 from sarcover.reports.plots import save_figure  # noqa: E402
 from sarcover.reports.style import look, ordered  # noqa: E402
 
 THRESHOLDS = (0.05, 0.01, 0.0)  # mean gaps whose first time the table gives
 AT_TIMES = (0.01, 0.1, 1.0, 10.0)  # seconds at which the table gives the mean gap
 _TOL = 1e-9
+_OWN_STOP = {"proof", "iteration_limit", "converged", "completed"}  # ended before the clock cut it
 
 
 def proven_optima(*frames: pd.DataFrame) -> pd.Series:
@@ -131,12 +136,25 @@ def runs_table(rows: pd.DataFrame, optima: pd.Series) -> pd.DataFrame:
         t, g = step_points(r, opt, "wall")
         tc, gc = step_points(r, opt, "cpu")
         info = r["info"] if isinstance(r["info"], dict) else {}
+        stop = info.get("stop_reason") or (stop_reason_of(r["termination"]) if r.get("termination") else None)
+        # the CPU seconds the run received: its last CPU point, or its runtime times its CPU share
+        # (NaN for a killed job, which records neither; filled in below from its method's share)
+        share = cpu_share(r)
+        known = ([float(r["runtime_s"]) * share] if np.isfinite(share) else []) + (
+            [cpu_times(r)[-1]] if info.get("history_cpu") else [])
+        cpu_end = max(known + [float(tc[-1])]) if known else np.nan
         out.append({"setting": setting_of(r), "instance": r["instance"], "method": r["method"],
                     "seed": r.get("seed", 0), "limit": float(r["time_limit"]), "times": t, "gaps": g,
                     "times_cpu": tc, "gaps_cpu": gc, "final_gap": float(g[-1]), "cpu_share": cpu_share(r),
                     "cpu_recorded": info.get("history_cpu") is not None, "status": r["status"],
-                    "stop_reason": info.get("stop_reason")})
-    return pd.DataFrame(out)
+                    "stop_reason": stop, "runtime_s": float(r["runtime_s"]),
+                    # CPU seconds up to which the run's CPU curve is measured (inf: it ended on its own)
+                    "cpu_covered": np.inf if stop in _OWN_STOP else cpu_end})
+    runs = pd.DataFrame(out)
+    if len(runs):
+        mean_share = runs.groupby(["setting", "method"])["cpu_share"].transform("mean").fillna(1.0)
+        runs["cpu_covered"] = runs["cpu_covered"].fillna(runs["runtime_s"] * mean_share)
+    return runs
 
 
 def setting_of(row) -> str:
@@ -173,13 +191,15 @@ def convergence_table(runs: pd.DataFrame) -> pd.DataFrame:
         for clock, t_col, g_col in (("wall", "times", "gaps"), ("cpu", "times_cpu", "gaps_cpu")):
             line[f"primal_integral_{clock}_s"] = float(np.mean(
                 [primal_integral(r[t_col], r[g_col], limit) for _, r in grp.iterrows()]))
-        t, g = mean_curve(grp, "wall")
-        for at in AT_TIMES:
-            line[f"gap_at_{at:g}s"] = float(gap_at(t, g, at)) if at <= limit + _TOL else float("nan")
+        covered = {"wall": limit, "cpu": float(min(grp["cpu_covered"].min(), limit))}
+        line["cpu_covered_s"] = covered["cpu"]
         for clock in ("wall", "cpu"):
             tc, gc = mean_curve(grp, clock)
+            suffix = "" if clock == "wall" else "_cpu"
+            for at in AT_TIMES:
+                line[f"gap_at_{at:g}s{suffix}"] = float(gap_at(tc, gc, at)) if at <= covered[clock] + _TOL else float("nan")
             for level in THRESHOLDS:
-                line[f"t_gap{level * 100:g}_{clock}_s"] = first_time(tc, gc, level, limit)
+                line[f"t_gap{level * 100:g}_{clock}_s"] = first_time(tc, gc, level, covered[clock])
         line["final_gap"] = float(grp["final_gap"].mean())
         line["optimal_runs"] = int((grp["final_gap"] <= _TOL).sum())
         line["cpu_share"] = float(grp["cpu_share"].mean())
@@ -206,13 +226,20 @@ def curves_table(runs: pd.DataFrame) -> pd.DataFrame:
 def plot_convergence(runs: pd.DataFrame, clock: str = "wall", ax=None, title: str | None = None,
                      t_min: float = 1e-3):
     """Mean gap to the optimum against time (log axis), one step line per method of ``runs``
-    (one setting). Draws on ``ax`` (a new one if None) and returns it; neither shows nor saves."""
+    (one setting), ending in the method's marker: at the limit, or on the CPU clock where the CPU
+    time of its runs was measured to. Draws on ``ax`` (a new one if None) and returns it; neither
+    shows nor saves."""
     if ax is None:
         _, ax = plt.subplots(figsize=(7, 4.5))
     limit = float(runs["limit"].max())
     for method in ordered(runs["method"].unique()):
-        t, g = mean_curve(runs[runs["method"] == method], clock)
-        t = np.append(np.maximum(t, t_min), limit)
+        grp = runs[runs["method"] == method]
+        t, g = mean_curve(grp, clock)
+        # on the CPU clock a curve ends where its runs' CPU time does (a run the wall-clock limit cut)
+        end = limit if clock == "wall" else float(min(grp["cpu_covered"].min(), limit))
+        keep = t <= end
+        t, g = t[keep], g[keep]
+        t = np.append(np.maximum(t, t_min), max(end, t_min))
         g = np.append(g, g[-1]) * 100
         lk = look(method)
         ax.step(t, g, where="post", color=lk.color, ls=lk.ls, lw=1.6, label=method)
@@ -229,15 +256,20 @@ def plot_convergence(runs: pd.DataFrame, clock: str = "wall", ax=None, title: st
 
 
 def _fmt_t(x: float, limit: float) -> str:
-    return f"> {limit:g}" if pd.isna(x) else (f"{x:.3g}" if x >= 0.001 else "< 0.001")
+    return f"> {limit:.2g}" if pd.isna(x) else (f"{x:.3g}" if x >= 0.001 else "< 0.001")
 
 
-def best_at(tab: pd.DataFrame, setting: str, at: float) -> tuple[list[str], float]:
-    """The methods with the lowest mean gap at ``at`` seconds in ``setting``, and that gap."""
-    col = f"gap_at_{at:g}s"
+def _fmt_gap(x: float) -> str:
+    return "n/m" if pd.isna(x) else f"{100 * x:.1f} %"
+
+
+def best_at(tab: pd.DataFrame, setting: str, at: float, clock: str = "wall") -> tuple[list[str], float, list[str]]:
+    """The methods with the lowest mean gap at ``at`` seconds in ``setting`` on ``clock``, that gap,
+    and the methods not measured that far on that clock (CPU clock: cut by the wall-clock limit)."""
+    col = f"gap_at_{at:g}s" + ("_cpu" if clock == "cpu" else "")
     sub = tab[tab["setting"] == setting]
     low = sub[col].min()
-    return list(sub[sub[col] <= low + 1e-12]["method"]), float(low)
+    return (list(sub[sub[col] <= low + 1e-12]["method"]), float(low), list(sub[sub[col].isna()]["method"]))
 
 
 def write_convergence(rows: pd.DataFrame, optimum_rows: list[pd.DataFrame], out: str | Path, *,
@@ -275,7 +307,13 @@ def write_convergence(rows: pd.DataFrame, optimum_rows: list[pd.DataFrame], out:
           "`info.history_cpu`), which load from other work on the machine does not inflate; where a method "
           "records no CPU times (bp keeps its own history) its wall times are scaled by the job's CPU share "
           "(cpu_s / wall_s), an estimate. \"CPU share\" is the mean of cpu_s / wall_s over the method's jobs, "
-          "\"CPU pts\" how many of its runs recorded CPU times.", ""]
+          "\"CPU pts\" how many of its runs recorded CPU times. The limit is on the wall clock, so a run it "
+          "cut received fewer CPU seconds than that: on the CPU clock a value is given only up to the CPU time "
+          "every run of the method either ended on its own (proof, iteration limit, construction) or reached "
+          "(\"CPU measured to\"); beyond it \"n/m\" (not measured), and \"> x\" means not reached by x s. "
+          "The CPU-clock primal integral holds a cut run at its final gap up to the limit, which is "
+          "pessimistic for the methods the wall clock cut. The gap at the limit counts what a run had by then: "
+          "a plan a method returns after its limit (its final point past it) does not count there.", ""]
     if left_out:
         L += [f"Left out (no proven optimum): {', '.join(left_out)}.", ""]
     for setting, grp in runs.groupby("setting", sort=False):
@@ -291,19 +329,28 @@ def write_convergence(rows: pd.DataFrame, optimum_rows: list[pd.DataFrame], out:
         sub = tab[tab["setting"] == setting]
         n_inst = int(sub["instances"].max())
         L += [f"{heading}# {setting} ({n_inst} instances with a proven optimum)", "", f"![mean gap against time, {setting}]({name})", ""]
-        head = ("| method | gap at " + " | ".join(f"{a:g} s" for a in AT_TIMES) + " | primal integral (s) wall / CPU | "
-                + " | ".join(f"t ≤ {lv * 100:g} % (s) wall / CPU" for lv in THRESHOLDS) + " | optimal | CPU share | CPU pts |")
-        L += [head, "|" + "---|" * (len(AT_TIMES) + len(THRESHOLDS) + 5)]
+        head = ("| method | gap at " + " | ".join(f"{a:g} s" for a in AT_TIMES) + " (wall / CPU) | primal integral (s) "
+                "wall / CPU | " + " | ".join(f"t ≤ {lv * 100:g} % (s) wall / CPU" for lv in THRESHOLDS)
+                + " | optimal | CPU share | CPU measured to (s) | CPU pts |")
+        L += [head, "|" + "---|" * (len(AT_TIMES) + len(THRESHOLDS) + 6)]
         for _, r in sub.iterrows():
-            cells = [f"{100 * r[f'gap_at_{a:g}s']:.1f} %" for a in AT_TIMES]
+            cells = [f"{_fmt_gap(r[f'gap_at_{a:g}s'])} / {_fmt_gap(r[f'gap_at_{a:g}s_cpu'])}" for a in AT_TIMES]
             cells.append(f"{r['primal_integral_wall_s']:.2f} / {r['primal_integral_cpu_s']:.2f}")
-            cells += [f"{_fmt_t(r[f't_gap{lv * 100:g}_wall_s'], limit)} / {_fmt_t(r[f't_gap{lv * 100:g}_cpu_s'], limit)}"
-                      for lv in THRESHOLDS]
-            cells += [f"{r['optimal_runs']}/{r['runs']}", f"{r['cpu_share']:.2f}", f"{r['cpu_recorded']}/{r['runs']}"]
+            cells += [f"{_fmt_t(r[f't_gap{lv * 100:g}_wall_s'], limit)} / "
+                      f"{_fmt_t(r[f't_gap{lv * 100:g}_cpu_s'], r['cpu_covered_s'])}" for lv in THRESHOLDS]
+            cells += [f"{r['optimal_runs']}/{r['runs']}", f"{r['cpu_share']:.2f}", f"{r['cpu_covered_s']:.2g}",
+                      f"{r['cpu_recorded']}/{r['runs']}"]
             L.append(f"| {r['method']} | " + " | ".join(cells) + " |")
         L.append("")
-        best = [f"{a:g} s: {', '.join(m)} ({100 * g:.1f} %)" for a in AT_TIMES for m, g in [best_at(tab, setting, a)]]
-        L += ["Lowest mean gap at " + "; ".join(best) + ".", ""]
+        for clock in ("wall", "cpu"):
+            best = []
+            for a in AT_TIMES:
+                m, g, unmeasured = best_at(tab, setting, a, clock)
+                text = f"{a:g} s: {', '.join(m)} ({100 * g:.1f} %)" if m else f"{a:g} s: –"
+                if unmeasured:
+                    text += f" among the methods measured that far (not: {', '.join(unmeasured)})"
+                best.append(text)
+            L += [f"Lowest mean gap on the {clock} clock at " + "; ".join(best) + ".", ""]
     L += [f"Data: `{prefix}_table.csv` (this table), `{prefix}_curves.csv` (the mean-gap step functions, both "
           f"clocks), `{prefix}_runs.csv` (each run's gap step function and CPU share).", ""]
     return "\n".join(L)

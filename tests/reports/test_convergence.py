@@ -16,9 +16,9 @@ from sarcover.reports.convergence import (
 
 
 def row(method, history, objective, *, instance="i1", status="feasible", runtime=None, cpu=None, share=(1.0, 1.0),
-        K=3, limit=10.0):
+        K=3, limit=10.0, stop="time_limit"):
     """A result row as the harness writes it, with only the fields the report reads."""
-    info = {"history": history}
+    info = {"history": history, "stop_reason": stop}
     if cpu is not None:
         info["history_cpu"] = cpu
     return {"instance": instance, "method": method, "seed": 0, "status": status, "objective": objective,
@@ -114,3 +114,25 @@ def test_files_without_a_grid_form_one_setting(tmp_path):
                           "kind": "top"}])
     text = write_convergence(rows, [], tmp_path)
     assert "### top (1 instances with a proven optimum)" in text and (tmp_path / "anytime_top.png").exists()
+
+
+def test_cpu_clock_is_not_extrapolated_past_the_cpu_a_cut_run_received():
+    """A run the wall-clock limit cut after 1.5 CPU seconds leaves its method's CPU-clock gap at
+    10 s unmeasured; a run that ended on its iteration limit counts at every later time."""
+    cut = row("x", [[2.0, 9.0, None], [10.0, 9.0, None]], 9.0, cpu=[0.5, 1.5], instance="a", share=(1.5, 10.0))
+    own = row("y", [[0.2, 9.0, None]], 9.0, cpu=[0.1], instance="a", stop="iteration_limit")
+    tab = convergence_table(runs_table(pd.DataFrame([cut, own]), pd.Series({"a": 10.0}))).set_index("method")
+    assert tab.loc["x", "cpu_covered_s"] == 1.5 and np.isnan(tab.loc["x", "gap_at_10s_cpu"])
+    assert tab.loc["x", "gap_at_1s_cpu"] == pytest.approx(0.1) and tab.loc["x", "gap_at_10s"] == pytest.approx(0.1)
+    assert tab.loc["y", "cpu_covered_s"] == 10.0 and tab.loc["y", "gap_at_10s_cpu"] == pytest.approx(0.1)
+
+
+def test_a_killed_job_is_measured_to_its_runtime_at_its_methods_cpu_share():
+    """A job killed past its limit (no info, no cpu_s) has no plan throughout, and its CPU curve
+    counts up to its wall runtime times the CPU share of its method's other jobs."""
+    ok = row("x", [[4.0, 10.0, None]], 10.0, cpu=[1.0], instance="a", share=(2.5, 10.0), runtime=10.0)
+    killed = {**row("x", [], None, instance="b", status="time_limit", runtime=17.0), "info": {},
+              "cpu_s": float("nan"), "termination": "time_limit"}
+    runs = runs_table(pd.DataFrame([ok, killed]), pd.Series({"a": 10.0, "b": 10.0}))
+    dead = runs.set_index("instance").loc["b"]
+    assert dead["gaps"].tolist() == [1.0] and dead["cpu_covered"] == pytest.approx(17.0 * 0.25)
