@@ -34,3 +34,18 @@ def test_record_keeps_one_cpu_time_per_kept_point():
     hist.record(info, float(3 * MAX_POINTS), None)
     assert len(info["history"]) == len(info["history_cpu"]) == MAX_POINTS
     assert info["history_cpu"] == sorted(info["history_cpu"]) and info["history"][-1][1] == 3 * MAX_POINTS
+
+
+def test_cpsat_holds_its_warm_start_from_the_start():
+    """cpsat's history starts with greedy's plan (its warm start, returned if nothing better is
+    found), and what it returns is never below it."""
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
+
+    inst = to_top(generate(20, 3, 5, seed=100))
+    greedy = run_method("greedy", inst)
+    res = run_method("cpsat", inst, time_limit=2.0)
+    hist = res.info["history"]
+    first = next(p for p in hist if p[1] is not None)
+    assert first[1] == greedy.objective and first[0] < 0.5 * hist[-1][0]
+    assert res.objective >= greedy.objective and hist[-1][1] == res.objective
