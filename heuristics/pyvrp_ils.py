@@ -248,7 +248,7 @@ def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: in
             client_of = {int(v): i for i, v in enumerate(nodes)}
             start_sol = Solution(m.data(), [[client_of[v] for v in r] for r in initial if r])
         criteria = [] if iterations is None else [MaxIterations(iterations)]
-        if deadline is not None:  # the clock starts after the model is built
+        if deadline is not None:  # what is left of the deadline once the model is built
             criteria.append(MaxRuntime(max(deadline - time.perf_counter(), 0.01)))
         if not criteria:
             raise ValueError("pyvrp needs a time limit or an iteration limit")

@@ -136,3 +136,28 @@ def test_a_killed_job_is_measured_to_its_runtime_at_its_methods_cpu_share():
     runs = runs_table(pd.DataFrame([ok, killed]), pd.Series({"a": 10.0, "b": 10.0}))
     dead = runs.set_index("instance").loc["b"]
     assert dead["gaps"].tolist() == [1.0] and dead["cpu_covered"] == pytest.approx(17.0 * 0.25)
+
+
+def test_suite_report_gains_the_section_when_heuristics_carry_histories(tmp_path):
+    """`sarcover report` on rows whose heuristics record histories writes anytime_report.md and
+    links it; rows from before histories (no heuristic history) get no such section."""
+    import json
+
+    from sarcover.benchmarks.cli import main
+
+    out = tmp_path / "res"
+    suite = tmp_path / "s.toml"
+    suite.write_text('methods = ["greedy", "adpc-pso", "milp"]\ntime_limit = 20\n[[instances]]\nM = 4\nK = 2\nN = 2\n'
+                     'runs = 2\nseed = 5\n')
+    assert main(["bench", str(suite), "-o", str(out), "--workers", "1", "--quiet"]) == 0
+    assert main(["report", str(out)]) == 0
+    rep = out / "report"
+    assert "anytime_report.md" in (rep / "report.md").read_text() and (rep / "anytime_table.csv").exists()
+    rows = [json.loads(line) for line in (out / "results.jsonl").read_text().splitlines()]
+    for r in rows:
+        if not r["exact"]:
+            r["info"].pop("history", None)
+    (out / "results.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    (rep / "anytime_report.md").unlink()
+    assert main(["report", str(out)]) == 0
+    assert not (rep / "anytime_report.md").exists()
