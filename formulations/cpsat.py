@@ -50,7 +50,7 @@ points in prize units (scaled objective / prize scale), t from the call of :func
 Incumbents: every solution CP-SAT reports (a solution callback) is read back into routes and
 verified; only truly feasible plans count, so every incumbent is at most the optimum (and the
 best of them is returned if the final plan is worse, e.g. a relaxed incumbent that had to be
-repaired). Bounds: only the relaxed model's, from ``best_bound_callback`` (and the final one),
+repaired); a valid warm start counts as the first incumbent, at its start. Bounds: only the relaxed model's, from ``best_bound_callback`` (and the final one),
 as ⌈bound - 1e-6⌉ / prize scale: the relaxed model is a relaxation of the true problem, so they
 are valid. The safe model is a restriction (capped at the relaxed bound), so its bounds say
 nothing about the true problem and are never recorded; only its verified plans are.
@@ -70,7 +70,7 @@ import numpy as np
 from ortools.sat.python import cp_model
 
 from sarcover.formulations.errors import SarcoverError
-from sarcover.formulations.history import History
+from sarcover.formulations.history import History, stop_reason_of
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
@@ -405,7 +405,8 @@ def solve_cpsat(
             # a truly feasible plan seen during the search beats the final one (e.g. a repaired one)
             plan, prize = best["plan"], best["prize"]
             reason = (reason + "; " if reason else "") + "returned the best verified plan seen during the search"
-        info["history"] = hist.finish(prize, bound)
+        hist.record(info, prize, bound)
+        info["stop_reason"] = stop_reason_of(termination)
         return Result("cpsat", termination, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
                       reason=reason, info=info)
 
@@ -425,6 +426,10 @@ def solve_cpsat(
     built = _Model(relaxed, iprize, model, None, flow)
     if warm_start is not None:
         built.add_hint(warm_start)
+        rep0 = verify(instance, warm_start)
+        if rep0.valid:  # held from the start: a stopped run returns it unless it found better (as milp)
+            best["plan"], best["prize"] = warm_start, rep0.prize
+            hist.update(incumbent=rep0.prize)
     solver = _solver(left(), threads, seed, linearization)
     # CP-SAT's bound on the scaled objective; the relaxed model's bound is valid for the true problem.
     solver.best_bound_callback = lambda b: hist.update(bound=math.ceil(b - 1e-6) / pscale)

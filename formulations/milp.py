@@ -67,7 +67,7 @@ from pyomo.contrib.solver.common.results import TerminationCondition
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import maximum_flow
 
-from sarcover.formulations.history import History
+from sarcover.formulations.history import History, stop_reason_of
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
@@ -433,7 +433,8 @@ def solve_milp(
         return None if deadline is None else max(deadline - time.perf_counter(), 0.0)
 
     def done(termination, plan=None, bound=None, reason=""):
-        info["history"] = hist.finish(verify(instance, plan).prize if plan is not None else None, bound)
+        hist.record(info, verify(instance, plan).prize if plan is not None else None, bound)
+        info["stop_reason"] = stop_reason_of(termination)
         info["runtime_model_s"] = round(time.perf_counter() - t0, 4)
         return Result(METHOD, termination, plan=plan, bound=bound, runtime_s=time.perf_counter() - t0,
                       reason=reason, info=info)

@@ -8,6 +8,8 @@ It is the energy repair's insertion phases (:class:`sarcover.heuristics.repair.R
 2. prizes: repeatedly the feasible insertion with the largest prize per added energy.
 
 Insertion costs are kept per route and only the route that changed is re-scored each round.
+Its anytime history (``info["history"]``) is the one point where its plan is complete; it stops
+when the construction ends (``info["stop_reason"] == "completed"``).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import time
 
 import numpy as np
 
+from sarcover.formulations.history import History, StopReason
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
@@ -26,6 +29,8 @@ from sarcover.heuristics.repair import Repairer
 def greedy(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = None) -> Result:
     """Deterministic insertion heuristic (``seed`` and ``time_limit`` are accepted and unused)."""
     t0 = time.perf_counter()
+    hist = History(t0)
+    info = {"stop_reason": StopReason.COMPLETED.value}
     repairer = Repairer(instance)
     rs = RouteSet(instance, repairer.C)
     reach = np.zeros(instance.n_nodes + 2, dtype=bool)
@@ -33,7 +38,10 @@ def greedy(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = N
     missing = repairer.cover(rs, reach)
     if missing is not None:
         what = "target" if instance.kind == "sar" else "group"
+        hist.record(info, None, None)
         return Result("greedy", Termination.COMPLETED, reason=f"greedy could not fit a viewpoint of {what} {missing}",
-                      runtime_s=time.perf_counter() - t0)
+                      runtime_s=time.perf_counter() - t0, info=info)
     repairer.fill(rs, reach)
-    return Result("greedy", Termination.COMPLETED, plan=Plan.of(rs.node_routes()), runtime_s=time.perf_counter() - t0)
+    plan = Plan.of(rs.node_routes())
+    hist.record(info, float(sum(instance.prizes[v] for v in plan.visited)), None)
+    return Result("greedy", Termination.COMPLETED, plan=plan, runtime_s=time.perf_counter() - t0, info=info)

@@ -5,8 +5,9 @@ a cold search gets ``COLD_SHARE`` of the time; if its best plan leaves a group u
 collects less than the `greedy` plan (which covers every group whenever greedy succeeds), a
 second search starts from greedy's plan with the remaining time, and the better of the two plans
 is returned. On tight SAR budgets the cold search sometimes never finds a covering plan, and with
-little CPU it can end far below greedy. When the cold plan is at least greedy's, the warm search
-is skipped: it gave worse plans than a cold one (``docs/heuristics.md``).
+little CPU it can end far below greedy. When the cold plan is at least greedy's, the second
+search continues from the cold plan instead (a search from greedy's plan gave worse plans than a
+cold one, ``docs/heuristics.md``), so the method uses the whole time limit it is given.
 
 Model (the sequence of the OR-Tools samples: build, set limits and strategy, solve, extract):
 
@@ -29,9 +30,14 @@ Model (the sequence of the OR-Tools samples: build, set limits and strategy, sol
   constraint ``sum(ActiveVar) >= 1`` and a mandatory cover disjunction were tried: every
   first-solution strategy then failed (``docs/heuristics.md``).
 - search: local cheapest insertion (or the given warm start), then guided local search,
-  single-threaded. It stops at ``time_limit`` or after ``solution_limit`` solutions,
-  whichever comes first. A run stopped by the solution limit is deterministic; one stopped by
-  time is not (``info["stopped_by"]`` says which).
+  single-threaded. It stops at ``time_limit`` (the caller's, with no cap of its own) or after
+  ``solution_limit`` solutions, whichever comes first. A run stopped by the solution limit is
+  deterministic; one stopped by time is not (``info["stopped_by"]`` says which, and
+  ``info["stop_reason"]`` is ``"iteration_limit"`` or ``"time_limit"``).
+- anytime history (``info["history"]``, :mod:`sarcover.formulations.history`): a solution
+  callback reads every solution the search accepts; one that lowers the search's objective and
+  covers every group is decoded into a plan and its prize logged, so the last point of each
+  search is the plan the search returns.
 """
 
 from __future__ import annotations
@@ -41,6 +47,7 @@ import time
 import numpy as np
 from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 
+from sarcover.formulations.history import History, StopReason
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
@@ -48,7 +55,6 @@ from sarcover.formulations.scaling import integer_arcs, integer_prizes, scaled_c
 from sarcover.formulations.verify import verify
 from sarcover.heuristics.greedy import greedy
 
-DEFAULT_TIME_CAP = 10.0  # seconds, when no time limit is given
 SOLUTION_LIMIT = 1000  # local-search solutions; the reproducible stop (~1-10 s at 60 nodes)
 METAHEURISTIC = "GUIDED_LOCAL_SEARCH"
 FIRST_SOLUTION = "LOCAL_CHEAPEST_INSERTION"
@@ -72,26 +78,37 @@ def solve_routing(
     metaheuristic: str = METAHEURISTIC,
     first_solution: str = FIRST_SOLUTION,
     gls_lambda: float = GLS_LAMBDA,
+    history: History | None = None,
 ) -> Result:
     """Prize-collecting TOP by OR-Tools routing with guided local search.
 
     ``seed`` is unused (OR-Tools routing has no seed; the search is deterministic when stopped
-    by ``solution_limit``). ``initial_routes`` (node ids, e.g. a greedy plan) warm-starts the
-    search; if the integer model rejects them (a route within rounding of the budget) the
-    search starts from local cheapest insertion instead (``info["warm_start"]`` says which).
-    ``metaheuristic``, ``first_solution``: names of OR-Tools' ``LocalSearchMetaheuristic`` and
+    by ``solution_limit``). ``time_limit`` None: the solution limit alone stops it.
+    ``initial_routes`` (node ids, e.g. a greedy plan) warm-starts the search; if the integer
+    model rejects them (a route within rounding of the budget) the search starts from local
+    cheapest insertion instead (``info["warm_start"]`` says which). ``metaheuristic``,
+    ``first_solution``: names of OR-Tools' ``LocalSearchMetaheuristic`` and
     ``FirstSolutionStrategy``; ``gls_lambda``: guided local search's penalty coefficient.
-"""
+    ``history``: where the search logs its improving plans (a caller running several searches
+    passes one; by default the search keeps its own and ``info["history"]`` holds it).
+    """
     t0 = time.perf_counter()
-    cap = DEFAULT_TIME_CAP if time_limit is None else float(time_limit)
+    own_history = history is None
+    hist = History(t0) if own_history else history
     nodes = _useful_nodes(instance)
     k, n_veh = len(nodes), instance.n_vehicles
+    def trivial(prize: float | None) -> dict:
+        info = {"stopped_by": "trivial", "stop_reason": StopReason.COMPLETED.value}
+        if own_history:
+            hist.record(info, prize, None)
+        return info
+
     if k == 0:
         if instance.groups:
             return Result("routing", Termination.COMPLETED, reason="no group node is reachable",
-                          runtime_s=time.perf_counter() - t0)
+                          runtime_s=time.perf_counter() - t0, info=trivial(None))
         return Result("routing", Termination.COMPLETED, plan=Plan.of([[] for _ in range(n_veh)]),
-                      runtime_s=time.perf_counter() - t0, info={"stopped_by": "trivial"})
+                      runtime_s=time.perf_counter() - t0, info=trivial(0.0))
 
     # Groups: every group node v gets a "cover copy" at the same place. Disjunction {v, copy}
     # (at most one active, penalty prize_v if neither) keeps v's prize exact and forbids a
@@ -108,7 +125,7 @@ def solve_routing(
                 locs.append(k + len(copies))
         if not locs:
             return Result("routing", Termination.COMPLETED, reason=f"group {gi} has no reachable node",
-                          runtime_s=time.perf_counter() - t0)
+                          runtime_s=time.perf_counter() - t0, info=trivial(None))
         group_locs.append(locs)
     model_nodes = np.concatenate([nodes, np.asarray(copies, dtype=int)]).astype(int)  # model loc - 1 -> node id
     n_loc = len(model_nodes) + 2
@@ -143,8 +160,9 @@ def solve_routing(
     params.local_search_metaheuristic = getattr(routing_enums_pb2.LocalSearchMetaheuristic, metaheuristic)
     if metaheuristic == "GUIDED_LOCAL_SEARCH":
         params.guided_local_search_lambda_coefficient = gls_lambda
-    remaining = max(cap - (time.perf_counter() - t0), 0.01)
-    params.time_limit.FromMilliseconds(max(int(remaining * 1000), 10))
+    remaining = None if time_limit is None else max(float(time_limit) - (time.perf_counter() - t0), 0.01)
+    if remaining is not None:
+        params.time_limit.FromMilliseconds(max(int(remaining * 1000), 10))
     params.log_search = False
 
     params.solution_limit = solution_limit
@@ -164,46 +182,71 @@ def solve_routing(
             loc_routes.append([manager.NodeToIndex(l) for l in locs])
         model.CloseModelWithParameters(params)
         warm = model.ReadAssignmentFromRoutes(loc_routes, True)
+    def plan_routes(value) -> list[list[int]]:
+        """The routes (node ids) of the current solution; ``value(var)`` reads a variable."""
+        routes = []
+        for veh in range(n_veh):
+            idx, route = value(model.NextVar(model.Start(veh))), []
+            while not model.IsEnd(idx):
+                route.append(int(model_nodes[manager.IndexToNode(idx) - 1]))
+                idx = value(model.NextVar(idx))
+            routes.append(route)
+        return routes
+
+    group_sets = [set(int(v) for v in g) for g in instance.groups]
+    seen = {"solutions": 0, "objective": None}
+
+    def at_solution():
+        seen["solutions"] += 1
+        obj = model.CostVar().Value()
+        if seen["objective"] is not None and obj >= seen["objective"]:
+            return
+        seen["objective"] = obj
+        routes = plan_routes(lambda var: var.Value())
+        visited = {v for r in routes for v in r}
+        if all(visited.intersection(g) for g in group_sets):
+            hist.update(float(sum(instance.prizes[v] for v in visited)))
+
+    model.AddAtSolutionCallback(at_solution)
     t_solve = time.perf_counter()
     if warm is not None:
         solution = model.SolveFromAssignmentWithParameters(warm, params)
     else:
         solution = model.SolveWithParameters(params)
     solve_s = time.perf_counter() - t_solve
-    info = {"scale": sc.scale, "nodes_modelled": k, "time_cap_s": cap, "solver_status": int(model.status()),
-            "warm_start": warm is not None}
+    by_solutions = seen["solutions"] >= solution_limit
+    info = {"scale": sc.scale, "nodes_modelled": k, "time_limit_s": remaining, "solver_status": int(model.status()),
+            "warm_start": warm is not None, "solutions": seen["solutions"],
+            "stopped_by": "solution_limit" if by_solutions else "time",
+            "stop_reason": (StopReason.ITERATION_LIMIT if by_solutions else StopReason.TIME_LIMIT).value}
+
+    def done(termination, plan=None, reason=""):
+        if own_history:
+            hist.record(info, None if plan is None else float(sum(instance.prizes[v] for v in plan.visited)), None)
+        return Result("routing", termination, plan=plan, reason=reason, runtime_s=time.perf_counter() - t0, info=info)
+
     if solution is None:
         what = "target" if instance.kind == "sar" else "group"
         reason = (f"OR-Tools routing found no plan covering every {what} in {solve_s:.3g} s"
                   if instance.groups else "OR-Tools routing found no solution")
-        return Result("routing", Termination.COMPLETED, reason=reason, runtime_s=time.perf_counter() - t0, info=info)
+        return done(Termination.COMPLETED, reason=reason)
 
-    routes = []
-    for veh in range(n_veh):
-        idx, route = model.Start(veh), []
-        idx = solution.Value(model.NextVar(idx))
-        while not model.IsEnd(idx):
-            route.append(int(model_nodes[manager.IndexToNode(idx) - 1]))
-            idx = solution.Value(model.NextVar(idx))
-        routes.append(route)
-    plan = Plan.of(routes)
+    plan = Plan.of(plan_routes(solution.Value))
+    routes = plan.routes
     visited = {v for r in routes for v in r}
     uncovered = [gi for gi, g in enumerate(instance.groups) if not visited.intersection(g)]
     if uncovered:
         what = "target" if instance.kind == "sar" else "group"
         info["uncovered"] = uncovered
-        return Result("routing", Termination.COMPLETED, runtime_s=time.perf_counter() - t0, info=info,
-                      reason=f"OR-Tools routing left {len(uncovered)} {what}(s) uncovered, e.g. {what} {uncovered[0]}")
-    info["stopped_by"] = "time" if solve_s >= remaining * 0.98 else "solution_limit"
+        return done(Termination.COMPLETED,
+                    reason=f"OR-Tools routing left {len(uncovered)} {what}(s) uncovered, e.g. {what} {uncovered[0]}")
     info["objective_int"] = int(solution.ObjectiveValue())
     report = verify(instance, plan)  # the integer model rounds up; this must never fail
     if not report.valid:
-        return Result("routing", Termination.ERROR, plan=plan, runtime_s=time.perf_counter() - t0,
-                      reason="routing plan failed verification: " + "; ".join(report.violations[:3]), info=info)
-    return Result("routing", Termination.COMPLETED, plan=plan, runtime_s=time.perf_counter() - t0, info=info)
+        return done(Termination.ERROR, plan, "routing plan failed verification: " + "; ".join(report.violations[:3]))
+    return done(Termination.COMPLETED, plan)
 
 
-TIME_CAP = 10.0  # seconds: the method runs at most min(time_limit, TIME_CAP)
 COLD_SHARE = 0.6
 
 
@@ -215,22 +258,38 @@ def _prize(instance: TOPInstance, result: Result) -> float:
 
 
 def routing(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0, **search) -> Result:
-    """OR-Tools routing heuristic: a plan or none, never a bound (``seed`` unused). ``search``:
-    :func:`solve_routing`'s search settings (``solution_limit``, ``metaheuristic``,
-    ``first_solution``, ``gls_lambda``) for both searches."""
+    """OR-Tools routing heuristic: a plan or none, never a bound (``seed`` unused).
+
+    ``time_limit`` (None: none, each search then ends at its solution limit) bounds the whole
+    method, and the method uses all of it unless its searches end on their solution limits:
+    with groups the cold search gets ``COLD_SHARE``, the second search the rest.
+    ``info["history"]`` spans both searches; ``info["stop_reason"]`` is the last search's.
+    ``search``: :func:`solve_routing`'s search settings (``solution_limit``, ``metaheuristic``,
+    ``first_solution``, ``gls_lambda``) for both searches.
+    """
     t0 = time.perf_counter()
-    cap = min(DEFAULT_TIME_CAP if time_limit is None else float(time_limit), TIME_CAP)
-    result = solve_routing(instance, time_limit=COLD_SHARE * cap if instance.groups else cap, **search)
+    hist = History(t0)
+    limit = None if time_limit is None else float(time_limit)
+    result = solve_routing(instance, time_limit=COLD_SHARE * limit if instance.groups and limit is not None else limit,
+                           history=hist, **search)
     result.info["phase"] = "cold"
     if instance.groups:
-        start = greedy(instance)
-        remaining = cap - (time.perf_counter() - t0)
-        if start.plan is not None and remaining > 0.05 and _prize(instance, result) < _prize(instance, start):
-            warm = solve_routing(instance, time_limit=remaining,
+        remaining = None if limit is None else limit - (time.perf_counter() - t0)
+        start, phase = greedy(instance), "greedy warm start"
+        if _prize(instance, result) >= _prize(instance, start):
+            start, phase = result, "continued from the cold plan"
+        if start.plan is not None and (remaining is None or remaining > 0.05):
+            warm = solve_routing(instance, time_limit=remaining, history=hist,
                                  initial_routes=[list(r) for r in start.plan.routes], **search)
-            warm.info["phase"] = "greedy warm start"
+            warm.info["phase"] = phase
+            stop = warm.info.get("stop_reason")
             if _prize(instance, warm) >= _prize(instance, result):
                 result = warm
+            result.info["stop_reason"] = stop
+        elif start.plan is not None:
+            result.info["stop_reason"] = StopReason.TIME_LIMIT.value
     result.method = "routing"
+    final = _prize(instance, result)
+    hist.record(result.info, final if final >= 0 else None, None)
     result.runtime_s = time.perf_counter() - t0
     return result

@@ -16,9 +16,11 @@ keeps the clusters (``clusters``) and, per route, the nodes repair or refill too
 its cluster (``outside_cluster``).
 
 Runs are seeded (``numpy.random.default_rng(seed)``; KMeans gets ``random_state=seed``) and
-stopped by iteration counts, so the same seed gives the same plan. ``time_limit`` is a safety
-net only: when it expires the routers stop iterating and ``info["stopped_by_time"]`` is set, and
-such a run is no longer reproducible.
+stopped by iteration counts, so the same seed gives the same plan (``info["stop_reason"]`` is
+``"iteration_limit"``). They also stop at ``time_limit``: when it expires the routers stop
+iterating, ``info["stopped_by_time"]`` is set and the stop reason is ``"time_limit"``; such a run
+is no longer reproducible. The anytime history (``info["history"]``) is one point: the plan
+exists only once the energy repair has made the tours feasible, and its prize is the plan's.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from typing import Callable
 
 import numpy as np
 
+from sarcover.formulations.history import History, StopReason
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
@@ -122,12 +125,13 @@ def _check_clusters(instance: TOPInstance, clusters) -> list[np.ndarray]:
     return clusters
 
 
-def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info, t0, c0, t1, c1,
+def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info, t0, c0, t1, c1, hist,
                  router_options=None) -> Result:
     """Route each cluster (router + 2-opt), then repair; route i is cluster i's UAV.
 
     ``clusters`` are node ids; the routers and the repair work in solver indices (id + 1).
-    Times from t0 (call) and t1 (end of clustering) go into ``info``.
+    Times from t0 (call) and t1 (end of clustering) go into ``info``; ``hist`` (started at the
+    call) gets the plan's prize once the repair has made it.
     """
     D = instance.distance_matrix()
     end = instance.n_nodes + 1
@@ -138,6 +142,7 @@ def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info
         tours = batch.routes(tours, best)
     tours = [two_opt(D, t, 0, end).tolist() for t in tours]
     info["stopped_by_time"] = bool(deadline is not None and time.perf_counter() > deadline)
+    info["stop_reason"] = (StopReason.TIME_LIMIT if info["stopped_by_time"] else StopReason.ITERATION_LIMIT).value
     t2, c2 = time.perf_counter(), time.thread_time()
 
     repairer = Repairer(instance, D=D)
@@ -145,6 +150,7 @@ def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info
         routes = repairer.repair(tours, reinsert=reinsert)
     except RepairFailed as exc:
         info.update(repairer.stats)
+        hist.record(info, None, None)
         return Result(name, Termination.COMPLETED, reason=str(exc), runtime_s=time.perf_counter() - t0, info=info)
     t3, c3 = time.perf_counter(), time.thread_time()
     info.update(repairer.stats)
@@ -155,7 +161,9 @@ def _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info
     outside = outside_clusters(routes, clusters)
     info["outside_cluster"] = outside
     info["n_outside_cluster"] = sum(len(o) for o in outside)
-    return Result(name, Termination.COMPLETED, plan=Plan.of(routes), runtime_s=time.perf_counter() - t0, info=info)
+    plan = Plan.of(routes)
+    hist.record(info, float(sum(instance.prizes[v] for v in plan.visited)), None)
+    return Result(name, Termination.COMPLETED, plan=plan, runtime_s=time.perf_counter() - t0, info=info)
 
 
 def route_clusters(
@@ -176,13 +184,14 @@ def route_clusters(
     route, the nodes the repair or refill put there from outside its cluster.
     """
     t0, c0 = time.perf_counter(), time.thread_time()
+    hist = History(t0)
     clusters = _check_clusters(instance, clusters)
     clusters += [np.zeros(0, dtype=int) for _ in range(instance.n_vehicles - len(clusters))]
     deadline = None if time_limit is None else t0 + float(time_limit)
     info: dict = {"clusterer": "given", "router": router, "cluster_sizes": [int(c.size) for c in clusters],
                   "clusters": [c.tolist() for c in clusters]}
     return _route_stage(instance, clusters, router, np.random.default_rng(seed), deadline, reinsert,
-                        name or f"given-{router}", info, t0, c0, t0, c0)
+                        name or f"given-{router}", info, t0, c0, t0, c0, hist)
 
 
 def cluster_then_route(
@@ -207,11 +216,14 @@ def cluster_then_route(
     lists per route the nodes repair or refill took from outside that cluster.
     """
     t0, c0 = time.perf_counter(), time.thread_time()
+    hist = History(t0)
     name = name or f"{clusterer}-{router}"
     deadline = None if time_limit is None else t0 + float(time_limit)
     rng = np.random.default_rng(seed)
     info: dict = {"clusterer": clusterer, "router": router}
     if not instance.reachable().any():
+        info["stop_reason"] = StopReason.COMPLETED.value
+        hist.record(info, None if instance.groups else 0.0, None)
         if instance.groups:
             return Result(name, Termination.COMPLETED, reason="no viewpoint is reachable within E_max",
                           runtime_s=time.perf_counter() - t0, info=info)
@@ -222,7 +234,7 @@ def cluster_then_route(
     info["cluster_sizes"] = [int(c.size) for c in clusters]
     info["clusters"] = [c.tolist() for c in clusters]
     t1, c1 = time.perf_counter(), time.thread_time()
-    return _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info, t0, c0, t1, c1,
+    return _route_stage(instance, clusters, router, rng, deadline, reinsert, name, info, t0, c0, t1, c1, hist,
                         router_options)
 
 

@@ -27,20 +27,33 @@ Model (PyVRP's ``Model`` builder):
   The better covering plan wins (pass 1 on ties). Both passes together beat pass 1 alone; pass 2
   alone (cold, then repair) was worse and its repair could fail (``docs/heuristics.md``). No
   covering plan from either pass: no plan.
-- stop (each pass): ``MaxIterations(ITERATIONS)`` (reproducible: same seed, same plan) or the time limit,
-  whichever comes first (``info["stopped_by"]``). Single-threaded.
+- stop: each pass ends at ``MaxIterations(iterations)`` (default :data:`ITERATIONS`, the
+  reproducible stop: same seed, same plan) or at its share of the time limit (pass 1 at
+  ``PASS1_SHARE`` of it, pass 2 at the limit itself), whichever comes first (``info[pass]
+  ["stopped_by"]``). The time limit is the caller's, with no cap of its own; ``iterations=None``
+  lets the time limit alone stop the passes. ``info["stop_reason"]`` is ``"iteration_limit"``
+  when both passes ended on their iterations, ``"time_limit"`` when the clock cut one short.
+  Single-threaded.
+- anytime history (``info["history"]``, :mod:`sarcover.formulations.history`): PyVRP's
+  ``on_best`` callback hands over each new best solution; it is decoded and repaired exactly as
+  the pass's final solution would be (pass 1: dedupe and refill; pass 2: group repair), and its
+  prize is logged when it beats every plan so far. So the history's last incumbent is the
+  returned plan's prize.
 """
 
 from __future__ import annotations
 
-import math
 import time
 import warnings
+from typing import Callable
 
 import numpy as np
 from pyvrp import Model, Solution
+from pyvrp.IteratedLocalSearch import IteratedLocalSearchCallbacks, IteratedLocalSearchParams
+from pyvrp.solve import SolveParams
 from pyvrp.stop import MaxIterations, MaxRuntime, MultipleCriteria
 
+from sarcover.formulations.history import History, StopReason
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.result import Result, Termination
@@ -48,9 +61,8 @@ from sarcover.formulations.scaling import integer_prizes, scaled_costs
 from sarcover.heuristics.insertion import RouteSet
 
 RESOLUTION = 10**5  # integer distance units per E_max (rounding loses <= 1e-5 E_max per arc)
-ITERATIONS = 2000  # ILS iterations, the reproducible stop
-TIME_CAP = 10.0  # seconds: the method runs at most min(time_limit, TIME_CAP)
-PASS1_SHARE = 0.6  # with groups: share of the time cap pass 1 may use
+ITERATIONS = 2000  # ILS iterations per pass, the reproducible stop
+PASS1_SHARE = 0.6  # with groups: share of the time limit pass 1 may use
 
 
 def _useful_nodes(instance: TOPInstance) -> np.ndarray:
@@ -146,14 +158,56 @@ def cover_groups(instance: TOPInstance, routes, refill: bool = False) -> list[li
     return rs.node_routes()
 
 
-def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: int, time_limit: float,
+def _with_callbacks(solve_params: SolveParams | None, callbacks) -> SolveParams:
+    """``solve_params`` (None: PyVRP's defaults) with ``callbacks`` in its ILS parameters."""
+    base = SolveParams() if solve_params is None else solve_params
+    ils = IteratedLocalSearchParams(num_iters_no_improvement=base.ils.num_iters_no_improvement,
+                                    history_length=base.ils.history_length,
+                                    exhaustive_on_best=base.ils.exhaustive_on_best, callbacks=callbacks)
+    return SolveParams(ils=ils, penalty=base.penalty, neighbourhood=base.neighbourhood, operators=base.operators,
+                       display_interval=base.display_interval, perturbation=base.perturbation)
+
+
+class _OnBest(IteratedLocalSearchCallbacks):
+    """Hands each new feasible best solution of the search to ``see`` (PyVRP's ``on_best``)."""
+
+    def __init__(self, see: Callable[[Solution], None]):
+        self.see = see
+
+    def on_best(self, best: Solution):
+        if best.is_feasible():
+            self.see(best)
+
+
+def _routes(best: Solution, client_nodes: np.ndarray, n_veh: int) -> tuple[list[list[int]], int]:
+    """A PyVRP solution as routes of node ids, and how many duplicate visits (a node visited as
+    itself and as its cover copy) were dropped: the first visit is kept (never costs more)."""
+    routes: list[list[int]] = [[] for _ in range(n_veh)]
+    seen: set[int] = set()
+    duplicates = 0
+    for r, route in enumerate(best.routes()):
+        for act in route:
+            if not act.is_client():
+                continue
+            v = int(client_nodes[act.idx])
+            if v in seen:
+                duplicates += 1
+            else:
+                seen.add(v)
+                routes[r].append(v)
+    return routes, duplicates
+
+
+def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: int, deadline: float | None,
            initial: list[list[int]] | None = None, iterations: int | None = ITERATIONS,
-           solve_params=None):
+           on_routes: Callable[[list[list[int]], int], None] | None = None, solve_params=None):
     """One PyVRP run; returns (routes as node ids or None if PyVRP found no feasible plan, info).
 
-    ``initial`` (node ids, without covers only) is PyVRP's warm start; ``iterations``: the ILS
-    iterations at most (None: the time limit alone stops it); ``solve_params``: PyVRP's
-    ``SolveParams`` (None: its defaults)."""
+    ``deadline`` (a ``time.perf_counter()`` value, None: none) stops the search; ``initial``
+    (node ids, without covers only) is PyVRP's warm start; ``iterations``: the ILS iterations at
+    most (None: the deadline alone stops it). ``on_routes(routes, duplicates)`` sees each new
+    feasible best solution during the search, as :func:`_routes` decodes it; ``solve_params``:
+    PyVRP's ``SolveParams`` (None: its defaults; the callbacks are added to a copy)."""
     n_veh = instance.n_vehicles
     sc = scaled_costs(instance, RESOLUTION)
     end = instance.n_nodes + 1
@@ -198,87 +252,101 @@ def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: in
     if not instance.same_depot:
         m.add_edge(start_loc, end_loc, 0)  # an empty route costs nothing
         m.add_edge(end_loc, start_loc, big)
-    runtime = MaxRuntime(max(time_limit, 0.01))
-    stop = runtime if iterations is None else MultipleCriteria([MaxIterations(iterations), runtime])
-    t_solve = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:  # PenaltyBoundWarning on (near-)infeasible data
         warnings.simplefilter("always")
         start_sol = None
         if initial is not None and not with_covers:
             client_of = {int(v): i for i, v in enumerate(nodes)}
             start_sol = Solution(m.data(), [[client_of[v] for v in r] for r in initial if r])
-        extra = {} if solve_params is None else {"params": solve_params}
-        res = m.solve(stop, seed=seed, collect_stats=False, display=False, initial_solution=start_sol, **extra)
-    solve_s = time.perf_counter() - t_solve
+        criteria = [] if iterations is None else [MaxIterations(iterations)]
+        if deadline is not None:  # what is left of the deadline once the model is built
+            criteria.append(MaxRuntime(max(deadline - time.perf_counter(), 0.01)))
+        if not criteria:
+            raise ValueError("pyvrp needs a time limit or an iteration limit")
+        stop = criteria[0] if len(criteria) == 1 else MultipleCriteria(criteria)
+        callbacks = None if on_routes is None else _OnBest(lambda sol: on_routes(*_routes(sol, client_nodes, n_veh)))
+        params = _with_callbacks(solve_params, callbacks)
+        res = m.solve(stop, seed=seed, collect_stats=False, display=False, params=params,
+                      initial_solution=start_sol)
     best = res.best
+    by_iterations = iterations is not None and res.num_iterations >= iterations
     info = {"scale": sc.scale, "iterations": int(res.num_iterations), "covers": with_covers,
-            "stopped_by": "time" if solve_s >= time_limit * 0.98 else "iterations",
+            "stopped_by": "iterations" if by_iterations else "time",
             "warnings": sorted({type(w.message).__name__ for w in caught})}
     if not best.is_feasible():
         return None, info
-    routes: list[list[int]] = [[] for _ in range(n_veh)]
-    seen: set[int] = set()
-    duplicates = 0
-    for r, route in enumerate(best.routes()):
-        for act in route:
-            if not act.is_client():
-                continue
-            v = int(client_nodes[act.idx])
-            if v in seen:  # visited as itself and as its cover copy: keep the first (never costs more)
-                duplicates += 1
-            else:
-                seen.add(v)
-                routes[r].append(v)
+    routes, duplicates = _routes(best, client_nodes, n_veh)
     info["duplicates_dropped"] = duplicates
     return routes, info
 
 
 def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
-          iterations: int | None = ITERATIONS, time_cap: float | None = None, solve_params=None) -> Result:
+          iterations: int | None = ITERATIONS, solve_params=None) -> Result:
     """Prize-collecting TOP by PyVRP (seeded, iteration-limited) plus group repair.
 
     With groups, pass 1 uses cover copies; pass 2 starts from pass 1's plan without them and
     repairs coverage afterwards (see the module docstring). ``iterations``: each pass's ILS
-    iterations at most (None: only the time limit, at most ``time_cap``, stops the passes).
-    ``time_cap``: the most seconds it runs (None: :data:`TIME_CAP`, the registered method's cap);
-    bp's primal calls after the first lift it (:func:`primal_routes`). ``solve_params``: PyVRP's
-    ``SolveParams`` for each pass (None: PyVRP's defaults).
+    iterations at most (None: only the time limit stops the passes); ``time_limit``: the
+    seconds the whole method may take (None: none, then ``iterations`` must be given);
+    ``solve_params``: PyVRP's ``SolveParams`` for each pass (None: PyVRP's defaults).
     """
     t0 = time.perf_counter()
-    time_cap = TIME_CAP if time_cap is None else time_cap
-    cap = min(time_cap if time_limit is None else float(time_limit), time_cap)
+    hist = History(t0)
+    deadline = None if time_limit is None else t0 + float(time_limit)
     nodes = _useful_nodes(instance)
     info: dict = {"nodes_modelled": int(len(nodes))}
     what = "target" if instance.kind == "sar" else "group"
+
+    def done(routes, reason: str = "") -> Result:
+        passes = [info[p] for p in ("pass1", "pass2") if p in info] or [info]
+        skipped = "pass1" in info and "pass2" not in info  # the clock left pass 2 no time
+        timed = skipped or any(p.get("stopped_by") == "time" for p in passes)
+        if "stop_reason" not in info:
+            info["stop_reason"] = (StopReason.TIME_LIMIT if timed else StopReason.ITERATION_LIMIT).value
+        plan = None if routes is None else Plan.of(routes)
+        hist.record(info, None if plan is None else _prize(instance, plan.routes), None)
+        return Result("pyvrp", Termination.COMPLETED, plan=plan, reason=reason,
+                      runtime_s=time.perf_counter() - t0, info=info)
+
+    def seen(routes) -> None:
+        if routes is not None:
+            hist.update(_prize(instance, routes))
+
     if len(nodes) == 0:
+        info["stop_reason"] = StopReason.COMPLETED.value
         if instance.groups:
-            return Result("pyvrp", Termination.COMPLETED, reason=f"no {what} node is reachable",
-                          runtime_s=time.perf_counter() - t0, info=info)
-        return Result("pyvrp", Termination.COMPLETED, plan=Plan.of([[] for _ in range(instance.n_vehicles)]),
-                      runtime_s=time.perf_counter() - t0, info={**info, "stopped_by": "trivial"})
+            return done(None, f"no {what} node is reachable")
+        info["stopped_by"] = "trivial"
+        return done([[] for _ in range(instance.n_vehicles)])
     if not instance.groups:
-        routes, run_info = _solve(instance, nodes, False, seed, cap, iterations=iterations, solve_params=solve_params)
+        def plain(routes, duplicates):
+            return cover_groups(instance, routes, refill=True) if duplicates else routes
+
+        routes, run_info = _solve(instance, nodes, False, seed, deadline, iterations=iterations,
+                                  on_routes=lambda r, d: seen(plain(r, d)), solve_params=solve_params)
         info.update(run_info)
         if routes is None:
-            return Result("pyvrp", Termination.COMPLETED, reason="PyVRP found no plan within the budget",
-                          runtime_s=time.perf_counter() - t0, info=info)
-        if run_info["duplicates_dropped"]:
-            routes = cover_groups(instance, routes, refill=True)
-        return Result("pyvrp", Termination.COMPLETED, plan=Plan.of(routes), runtime_s=time.perf_counter() - t0, info=info)
+            return done(None, "PyVRP found no plan within the budget")
+        return done(plain(routes, run_info["duplicates_dropped"]))
 
     # pass 1: cover copies, so PyVRP itself covers every group; then dedupe and refill
+    def first(routes, duplicates):
+        return cover_groups(instance, routes, refill=bool(duplicates))
+
     reason = "PyVRP found no plan within the budget"
     best_routes = None
-    routes, run_info = _solve(instance, nodes, True, seed, PASS1_SHARE * cap, iterations=iterations,
-                              solve_params=solve_params)
+    share = None if deadline is None else t0 + PASS1_SHARE * float(time_limit)
+    routes, run_info = _solve(instance, nodes, True, seed, share, iterations=iterations,
+                              on_routes=lambda r, d: seen(first(r, d)), solve_params=solve_params)
     info["pass1"] = run_info
     if routes is not None:
-        best_routes = cover_groups(instance, routes, refill=bool(run_info["duplicates_dropped"]))
+        best_routes = first(routes, run_info["duplicates_dropped"])
+        seen(best_routes)
     # pass 2: no covers (no duplicate distortion), warm-started from pass 1; repair coverage after
-    remaining = cap - (time.perf_counter() - t0)
-    if remaining > 0.05:
-        routes, run_info = _solve(instance, nodes, False, seed, remaining, initial=best_routes,
-                                  iterations=iterations, solve_params=solve_params)
+    if deadline is None or deadline - time.perf_counter() > 0.05:
+        routes, run_info = _solve(instance, nodes, False, seed, deadline, initial=best_routes,
+                                  iterations=iterations, on_routes=lambda r, d: seen(cover_groups(instance, r)),
+                                  solve_params=solve_params)
         info["pass2"] = run_info
         if routes is not None:
             repaired = cover_groups(instance, routes)
@@ -289,9 +357,8 @@ def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60
                 info["best_pass"] = 2
     if best_routes is not None:
         info.setdefault("best_pass", 1)
-        return Result("pyvrp", Termination.COMPLETED, plan=Plan.of(best_routes),
-                      runtime_s=time.perf_counter() - t0, info=info)
-    return Result("pyvrp", Termination.COMPLETED, reason=reason, runtime_s=time.perf_counter() - t0, info=info)
+        return done(best_routes)
+    return done(None, reason)
 
 
 def primal_routes(instance: TOPInstance, seed: int):
@@ -299,16 +366,15 @@ def primal_routes(instance: TOPInstance, seed: int):
     that time, or None without a plan. The first call is the registered method (``seed``,
     ``ITERATIONS`` per pass: a good plan in a few seconds); each later call searches with a new
     seed until its time is up, since on M = 20, K = 3 PyVRP still finds better plans after 2000
-    iterations and another seed finds others, and on K = 5-6 a longer search than the method's
-    :data:`TIME_CAP` finds better ones still (docs/bp.md): those calls take all the seconds bp
-    gives them."""
+    iterations and another seed finds others, and on K = 5-6 a longer search finds better ones
+    still (docs/bp.md): those calls take all the seconds bp gives them."""
     calls = 0
 
     def run(seconds: float):
         nonlocal calls
         first = calls == 0
         res = pyvrp(instance, seed=seed + calls, time_limit=max(seconds, 0.05),
-                    iterations=ITERATIONS if first else None, time_cap=None if first else math.inf)
+                    iterations=ITERATIONS if first else None)
         calls += 1
         return None if res.plan is None else [list(r) for r in res.plan.routes]
 

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from sarcover.reports.convergence import write_convergence
 from sarcover.reports.decomposition import write_decomposition
 from sarcover.reports.optimum import optimum_section
 from sarcover.reports.plots import save_figure, subplots
@@ -303,6 +304,8 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
     if opt is not None:
         L += optimum_section(opt, out)
     L += _decomposition_section(root, out)
+    if (anytime := _load(root, "anytime")) is not None:  # gap over time; optima also from paper-opt's proofs
+        L += [write_convergence(anytime, [opt] if opt is not None else [], out)]
     L += _top_section(top, out)
     if top47 is not None:
         L += top_sets_section(top47, out)

@@ -421,6 +421,14 @@ def write_report(results_dir: str | Path, out_dir: str | Path) -> str:
     _gap_distributions(gapped, out, doc)
     _time_to_optimality(gapped, out, doc)
     _anytime(df, inst, out, doc)
+    if n_opt and {"exact", "info"} <= set(df) and df.loc[~df["exact"].astype(bool), "info"].map(
+            lambda i: isinstance(i, dict) and "history" in i).any():
+        from sarcover.reports.convergence import write_convergence  # every method's gap against time
+
+        (out / "anytime_report.md").write_text(write_convergence(df, [], out, heading="#"))
+        doc.h("Gap over time for every method")
+        doc.p("Mean gap to the proven optimum against time, primal integrals and times to 5 %, 1 %, 0 %: "
+              "[anytime_report.md](anytime_report.md).")
     gapped.drop(columns=["routes", "info", "source", "versions", "params", "energy", "covered"], errors="ignore").to_csv(
         out / "runs.csv", index=False)
     parquet = _parquet(df, out / "results.parquet")

@@ -50,21 +50,6 @@ def test_bps_primal_heuristic_is_the_method_first_then_searches_its_time():
     assert verify(inst, Plan.of(routes)).valid
 
 
-def test_bps_later_primal_calls_are_not_held_to_the_methods_time_cap(monkeypatch):
-    """The registered method stops at TIME_CAP; bp's later primal calls search for all the
-    seconds bp gives them (a longer search finds better plans at K = 5-6)."""
-    import sarcover.heuristics.pyvrp_ils as pyvrp_ils
-
-    monkeypatch.setattr(pyvrp_ils, "TIME_CAP", 0.3)
-    inst = to_top(generate(8, 2, 2, 0, e_max=6000.0))
-    run = primal_routes(inst, 0)
-    run(1.2)  # the first call: the method, iteration-stopped
-    t = time.perf_counter()
-    routes = run(1.2)
-    assert time.perf_counter() - t >= 1.1
-    assert verify(inst, Plan.of(routes)).valid
-
-
 def test_cover_groups_repairs_an_uncovering_plan():
     """A plan missing a group gets the group inserted, evicting the cheapest prize per energy."""
     inst = TOPInstance(coords=np.array([[0, 4.0], [3, 0.0], [0, -4.0]]), prizes=np.array([5.0, 1.0, 0.0]),
