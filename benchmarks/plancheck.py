@@ -149,7 +149,8 @@ def check_plan(instance: TOPInstance, plan: Plan, results: str | Path | None = N
                      total_prize=instance.total_prize, budget=instance.budget, known=known, notes=tuple(notes))
 
 
-def known_value(instance: TOPInstance, results: str | Path | None = None, notes: list[str] | None = None) -> Known | None:
+def known_value(instance: TOPInstance, results: str | Path | None = None,
+                notes: list[str] | None = None) -> Known | None:
     """The best thing known of ``instance``'s optimum, in the order of the module's docstring: a
     proven optimum (the results folder's first, then the regression table's, then the published
     one), a proven infeasibility, the results folder's best bound, a published best known value.

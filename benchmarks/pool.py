@@ -62,9 +62,9 @@ def redirect_output(output: str | Path | None) -> None:
     except OSError:
         return
     # Python-level streams that do not write to the file descriptors (a test's capture) follow too
-    sys.stdout = open(1, "w", buffering=1, closefd=False)  # noqa: SIM115 - lives as long as the process
+    sys.stdout = open(1, "w", buffering=1, closefd=False)
     if output is not None:
-        sys.stderr = open(2, "w", buffering=1, closefd=False)  # noqa: SIM115
+        sys.stderr = open(2, "w", buffering=1, closefd=False)
 
 
 def cap_memory(memory_mb: int) -> None:

@@ -274,7 +274,7 @@ def run_method(name: str, instance: TOPInstance, *, seed: int = 0,
     t0 = time.perf_counter()
     try:
         result = spec.run(instance, seed=seed, time_limit=time_limit, **resolved)
-    except Exception as exc:  # a method bug must not stop a benchmark
+    except Exception as exc:  # noqa: BLE001 - a method bug must not stop a benchmark
         tb = traceback.format_exc().strip().splitlines()
         return VerifiedResult.failed(spec.name, Termination.ERROR, f"{type(exc).__name__}: {exc}",
                                      time.perf_counter() - t0, info={**info, "traceback": tb})

@@ -97,7 +97,7 @@ def run_one(job: dict) -> dict:
         row["threads"] = run.info.get("threads")
         if isinstance(run.info.get("params"), dict):  # what the method ran with, every default filled in
             row["params"] = run.info["params"]
-    except BaseException as exc:  # noqa: BLE001 - a job must never take the harness down
+    except BaseException as exc:
         if isinstance(exc, KeyboardInterrupt):
             raise
         row.update(termination="error", solution="none", status="error")

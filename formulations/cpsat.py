@@ -50,7 +50,8 @@ points in prize units (scaled objective / prize scale), t from the call of :func
 Incumbents: every solution CP-SAT reports (a solution callback) is read back into routes and
 verified; only truly feasible plans count, so every incumbent is at most the optimum (and the
 best of them is returned if the final plan is worse, e.g. a relaxed incumbent that had to be
-repaired); a valid warm start counts as the first incumbent, at its start. Bounds: only the relaxed model's, from ``best_bound_callback`` (and the final one),
+repaired); a valid warm start counts as the first incumbent, at its start. Bounds: only the
+relaxed model's, from ``best_bound_callback`` (and the final one),
 as ⌈bound - 1e-6⌉ / prize scale: the relaxed model is a relaxation of the true problem, so they
 are valid. The safe model is a restriction (capped at the relaxed bound), so its bounds say
 nothing about the true problem and are never recorded; only its verified plans are.

@@ -46,7 +46,8 @@ from sarcover.formulations.result import VerifiedResult, split_status
 SCHEMA_VERSION = 2
 RESULTS_FILE = "results.jsonl"
 
-IDENTITY = ("schema", "key", "suite", "instance", "method", "params", "exact", "seed", "run", "source", "kind", "M", "K",
+IDENTITY = ("schema", "key", "suite", "instance", "method", "params", "exact", "seed", "run", "source", "kind",
+            "M", "K",
             "N", "instance_seed", "n_nodes", "n_groups", "n_vehicles", "reference", "best_known")
 OUTCOME = ("termination", "solution", "status", "objective", "bound", "coverage", "covered", "routes", "energy",
            "energy_used", "e_max", "valid", "reason", "info")

@@ -150,10 +150,10 @@ def solve_routing(
     copy_of = {v: k + 1 + i for i, v in enumerate(copies)}
     for loc in range(1, k + 1):
         members = [loc] + ([copy_of[int(nodes[loc - 1])]] if int(nodes[loc - 1]) in copy_of else [])
-        model.AddDisjunction([manager.NodeToIndex(l) for l in members], int(penalty[loc - 1]), 1)
+        model.AddDisjunction([manager.NodeToIndex(loc_) for loc_ in members], int(penalty[loc - 1]), 1)
     group_penalty = int(penalty.sum()) + max_travel + 1  # one uncovered group outweighs everything else
     for locs in group_locs:
-        model.AddDisjunction([manager.NodeToIndex(l) for l in locs], group_penalty, 1)
+        model.AddDisjunction([manager.NodeToIndex(loc_) for loc_ in locs], group_penalty, 1)
 
     params = pywrapcp.DefaultRoutingSearchParameters()
     params.first_solution_strategy = getattr(routing_enums_pb2.FirstSolutionStrategy, first_solution)
@@ -179,7 +179,7 @@ def solve_routing(
                     locs.append(copy_of[int(v)])  # the group's cover copy
                 elif int(v) in pos:
                     locs.append(pos[int(v)])
-            loc_routes.append([manager.NodeToIndex(l) for l in locs])
+            loc_routes.append([manager.NodeToIndex(loc_) for loc_ in locs])
         model.CloseModelWithParameters(params)
         warm = model.ReadAssignmentFromRoutes(loc_routes, True)
     def plan_routes(value) -> list[list[int]]:

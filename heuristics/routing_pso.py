@@ -123,7 +123,8 @@ class PSORouter:
         return best, gbest_f
 
     def _move(self, x, v, pbest, pbest_f, gbest, r1, r2, evaluate):
-        """One PSO move, fitness and personal bests in numpy (:func:`sarcover.heuristics.kernels.pso_iterations` compiled)."""
+        """One PSO move, fitness and personal bests in numpy (compiled:
+        :func:`sarcover.heuristics.kernels.pso_iterations`)."""
         v = self.w * v + self.c1 * r1 * (pbest - x) + self.c2 * r2 * (gbest[:, None, :] - x)
         np.clip(v, -self.v_max, self.v_max, out=v)
         x = x + v
@@ -136,7 +137,6 @@ class PSORouter:
     @staticmethod
     def _improve(D, batch: ClusterBatch, gbest: np.ndarray, gbest_f: np.ndarray):
         """One best-improvement 2-opt move on each swarm's global best, written back as keys."""
-        pad = batch.pad
         order = np.argsort(gbest, axis=-1)
         seqs = batch.to_global(order)
         lo, hi, gain = best_two_opt_moves(D, seqs, batch.sizes, batch.start, batch.end)

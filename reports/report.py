@@ -429,7 +429,8 @@ def write_report(results_dir: str | Path, out_dir: str | Path) -> str:
         doc.h("Gap over time for every method")
         doc.p("Mean gap to the proven optimum against time, primal integrals and times to 5 %, 1 %, 0 %: "
               "[anytime_report.md](anytime_report.md).")
-    gapped.drop(columns=["routes", "info", "source", "versions", "params", "energy", "covered"], errors="ignore").to_csv(
+    dropped = ["routes", "info", "source", "versions", "params", "energy", "covered"]
+    gapped.drop(columns=dropped, errors="ignore").to_csv(
         out / "runs.csv", index=False)
     parquet = _parquet(df, out / "results.parquet")
     (out / "report.md").write_text(doc.markdown())

@@ -31,7 +31,8 @@ def slow_all(instance, *, seed=0, time_limit=None):
 
 def all_optimal(instance, *, seed=0, time_limit=None):
     """Every node on vehicle 1, claimed optimal with bound = total prize (tiny easy instances)."""
-    return Result("all", Termination.OPTIMAL, Plan.of([list(range(instance.n_nodes))] + [[]] * (instance.n_vehicles - 1)),
+    routes = [list(range(instance.n_nodes))] + [[]] * (instance.n_vehicles - 1)
+    return Result("all", Termination.OPTIMAL, Plan.of(routes),
                   bound=float(instance.total_prize))
 
 

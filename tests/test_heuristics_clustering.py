@@ -14,7 +14,8 @@ CENTRES = np.array([[0.0, 0.0], [20.0, 0.0], [10.0, 30.0]])
 
 def blobs() -> np.ndarray:
     """Three symmetric blobs: a centre, 6 points at radius 1 and 12 at radius 2.5."""
-    ring = lambda r, n: r * np.c_[np.cos(np.arange(n) * 2 * np.pi / n), np.sin(np.arange(n) * 2 * np.pi / n)]
+    def ring(r, n):
+        return r * np.c_[np.cos(np.arange(n) * 2 * np.pi / n), np.sin(np.arange(n) * 2 * np.pi / n)]
     shape = np.vstack([[0.0, 0.0], ring(1.0, 6), ring(2.5, 12)])
     return np.vstack([c + shape for c in CENTRES])
 

@@ -28,7 +28,8 @@ def random_instance(seed: int) -> TOPInstance:
         coords[: v // 2] = coords[0]  # duplicated points
     ids = rng.permutation(v)
     n_groups = int(rng.integers(0, min(v, 4) + 1))
-    groups = tuple(tuple(int(i) for i in part) for part in np.array_split(ids[: 2 * n_groups], n_groups) if len(part)) if n_groups else ()
+    parts = np.array_split(ids[: 2 * n_groups], n_groups) if n_groups else []
+    groups = tuple(tuple(int(i) for i in part) for part in parts if len(part))
     start = rng.uniform(0, 100, 2)
     end = start if rng.random() < 0.5 else rng.uniform(0, 100, 2)
     return TOPInstance(

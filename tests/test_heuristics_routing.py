@@ -50,7 +50,7 @@ def test_convex_polygon_hull_order(name, seed):
 def test_batched_clusters_of_different_sizes(name):
     """Clusters padded into one batch are each solved to their hull tour; trivial ones pass through."""
     sizes = [4, 9, 1, 0, 6]
-    blocks, hulls, offset = [], [], 0
+    hulls = []
     coords = [np.zeros(2)]
     rng = np.random.default_rng(7)
     clusters = []

@@ -74,7 +74,8 @@ def _synthetic(directory, n_instances=100, methods=("exact", "a", "b", "c")):
         for m in methods:
             obj = opt if m == "exact" else opt - rng.randint(0, 3)
             lines.append({
-                "schema": SCHEMA_VERSION, "key": f"i{i}|{m}|0", "suite": "bench", "instance": f"sar-m5-k2-n{2 + i % 3}-s{i}",
+                "schema": SCHEMA_VERSION, "key": f"i{i}|{m}|0", "suite": "bench",
+                "instance": f"sar-m5-k2-n{2 + i % 3}-s{i}",
                 "method": m, "exact": m == "exact", "seed": 0, "run": i, "kind": "sar", "M": 5, "K": 2, "N": 2 + i % 3,
                 "instance_seed": i, "n_nodes": 10, "reference": None,
                 "status": ("optimal" if proven else "time_limit") if m == "exact" else "feasible",

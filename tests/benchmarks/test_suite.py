@@ -120,7 +120,8 @@ def test_bad_parameters_in_a_suite_are_one_line_before_anything_runs(tmp_path, c
 @pytest.mark.parametrize("body, needle", [
     ('methods = ["greedy", "no-such-method"]\n[[instances]]\nM = 3\nK = 2\nN = 1', "unknown method 'no-such-method'"),
     ('methods = ["greedy"]\n[[instances]]\nM = 3\nK = 0\nN = 1', "K must be >= 1"),
-    ('methods = ["greedy"]\ntime_limit = "long"\n[[instances]]\nM = 3\nK = 2\nN = 1', "time_limit must be a finite number"),
+    ('methods = ["greedy"]\ntime_limit = "long"\n[[instances]]\nM = 3\nK = 2\nN = 1',
+     "time_limit must be a finite number"),
     ('methods = ["greedy"]\n[[instances]]\nM = 3\nK = 2\nN = 1\nviews = 4', "unknown key 'views'"),
     ('methods = ["greedy"]\n[[instances]]\nfiles = ["p9.9.z"]', "instance file 'p9.9.z' not found"),
     ('methods = ["greedy"]\n[[instances]]\nfiles = ["missing.json"]', "instance file 'missing.json' not found"),
