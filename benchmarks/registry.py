@@ -103,7 +103,7 @@ def cpsat(instance, *, seed=0, time_limit=60.0) -> Result:
 
 def bp(instance, *, seed=0, time_limit=60.0) -> Result:
     from sarcover.formulations.bp import BPOptions, solve_bp
-    from sarcover.formulations.bp.pricing import warm_up
+    from sarcover.formulations.bp import warm_up
     from sarcover.heuristics.pyvrp_ils import primal_routes
 
     warm_up()  # numba compilation (or loading it from the disk cache) is not the method's time
@@ -120,7 +120,7 @@ def compile_routers() -> None:
 
 
 def compile_bp() -> None:
-    from sarcover.formulations.bp.pricing import warm_up
+    from sarcover.formulations.bp import warm_up
 
     warm_up()
 

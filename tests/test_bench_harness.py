@@ -382,7 +382,7 @@ def test_ctrl_c_records_the_part_of_the_run_that_was_stored(tmp_path):
 WARM_CHECK = r"""
 import json, sys
 from numba.core.registry import CPUDispatcher
-import sarcover.formulations.bp.pricing as pricing
+from sarcover.formulations.bp.compile import KERNEL_MODULES
 import sarcover.heuristics.kernels as kernels
 from sarcover.benchmarks.registry import METHODS, run_method, warm_up
 from sarcover.formulations.generate import generate
@@ -390,7 +390,7 @@ from sarcover.formulations.instance import to_top
 
 def compiled():
     out = {}
-    for mod in (pricing, kernels):
+    for mod in (*KERNEL_MODULES, kernels):
         for name in dir(mod):
             f = getattr(mod, name)
             if isinstance(f, CPUDispatcher):
@@ -417,7 +417,7 @@ def test_warm_up_leaves_nothing_for_the_jobs_to_compile():
     data = json.loads(out.stdout.strip().splitlines()[-1])
     assert sorted(data["hooks"]) == ["compile_bp", "compile_routers"]
     assert sum(data["before"].values()) == 0  # a fresh process: nothing compiled yet
-    assert data["warmed"]["sarcover.formulations.bp.pricing._label"] > 0
+    assert data["warmed"]["sarcover.formulations.bp.labelling.label_search"] > 0
     assert data["warmed"]["sarcover.heuristics.kernels.pso_iterations"] > 0
     assert data["after"] == data["warmed"]
     assert set(data["statuses"].values()) <= {"optimal", "feasible"}

@@ -10,11 +10,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from sarcover.benchmarks.registry import run_method
 from sarcover.formulations.bp import BPOptions, solve_bp
-from sarcover.formulations.bp.options import (CUTS_FROM_S, ENUM_FROM_S, ENUM_LABELS, ENUM_LABELS_FROM_S,
-                                              MORE_PRIMAL_FROM_S, OPEN_CUTS_FROM_S)
+from sarcover.formulations.bp.options import (
+    CUTS_FROM_S,
+    ENUM_FROM_S,
+    ENUM_LABELS,
+    ENUM_LABELS_FROM_S,
+    MORE_PRIMAL_FROM_S,
+    OPEN_CUTS_FROM_S,
+)
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.io import load_instance
 from sarcover.formulations.plan import Plan
@@ -187,7 +192,7 @@ def test_sar_infeasible_when_targets_do_not_fit():
 
 def _tiny_pricing(seed: int, n_nodes: int = 7):
     """A random pricing problem: Euclidean arcs with an image cost, reduced prizes of both signs."""
-    from sarcover.formulations.bp.pricing import cheapest_return
+    from sarcover.formulations.bp.graph import cheapest_return
 
     rng = np.random.default_rng(seed)
     inst = TOPInstance(coords=rng.uniform(0, 10, size=(n_nodes, 2)), prizes=np.ones(n_nodes),
@@ -217,7 +222,8 @@ def test_exact_pricing_matches_enumeration(seed, bidirectional):
     """Elementary labelling (heap order, buckets, reach-filtered completion bound): its best value
     is the best elementary path's prize, its routes are real improving paths; ng-8 labelling and the
     heuristic bracket it (ng value >= elementary best >= any heuristic route)."""
-    from sarcover.formulations.bp.pricing import full_ng, nearest_ng, price
+    from sarcover.formulations.bp.labelling import price
+    from sarcover.formulations.bp.ng_sets import full_ng, nearest_ng
 
     cost, ret, profit, budget = _tiny_pricing(seed)
     paths = _brute_paths(cost, profit, budget)
@@ -245,7 +251,8 @@ def test_exact_pricing_keeps_near_best_routes_without_losing_the_best(seed):
     value stays the best elementary prize, every route returned is a real improving path, the
     best comes first, and more of the near-best routes come back (the point of it: more columns
     per exact call)."""
-    from sarcover.formulations.bp.pricing import full_ng, price
+    from sarcover.formulations.bp.labelling import price
+    from sarcover.formulations.bp.ng_sets import full_ng
 
     cost, ret, profit, budget = _tiny_pricing(seed, n_nodes=9)
     paths = _brute_paths(cost, profit, budget)
@@ -266,7 +273,9 @@ def test_exact_pricing_keeps_near_best_routes_without_losing_the_best(seed):
 @pytest.mark.parametrize("seed", range(4))
 def test_completion_bound_covers_every_suffix(seed):
     """_completion never undercuts the best elementary suffix of a path prefix (enumerated)."""
-    from sarcover.formulations.bp.pricing import _completion, _prepare, n_words
+    from sarcover.formulations.bp.bounds import completion_bound as _completion
+    from sarcover.formulations.bp.bounds import completion_data as _prepare
+    from sarcover.formulations.bp.ng_sets import n_words
 
     cost, ret, profit, budget = _tiny_pricing(seed)
     n = cost.shape[0]
@@ -302,7 +311,8 @@ def _branch_like(cost: np.ndarray, seed: int) -> None:
 def test_suffix_tables_cover_every_suffix(seed):
     """The DP suffix bound never undercuts the best elementary suffix of a path prefix
     (enumerated), also on a graph with forbidden arcs and no triangle inequality."""
-    from sarcover.formulations.bp.pricing import _dp_bound, suffix_tables
+    from sarcover.formulations.bp.bounds import dp_bound as _dp_bound
+    from sarcover.formulations.bp.bounds import suffix_tables
 
     cost, ret, profit, budget = _tiny_pricing(seed)
     if seed >= 2:
@@ -329,7 +339,7 @@ def test_arc_bounds_cover_every_path_through_an_arc(seed):
     """The arc bound (best prefix + arc + best suffix) is never below the prize of an elementary
     path through that arc (enumerated), also with forbidden arcs and no triangle inequality; and
     it is not vacuous: on these graphs it is finite and below the largest bound somewhere."""
-    from sarcover.formulations.bp.pricing import arc_bounds
+    from sarcover.formulations.bp.arc_bounds import arc_bounds
 
     cost, ret, profit, budget = _tiny_pricing(seed)
     n = cost.shape[0]
@@ -353,7 +363,8 @@ def test_label_arc_bounds_cover_every_path_above_the_threshold(seed, ng_size):
     """The labelling arc bound (ng-labels forward and backward, fixed threshold) is never below
     the prize of an elementary path through the arc whose prize beats the threshold; with
     elementary labels it is tighter than the DP arc bound on some arc."""
-    from sarcover.formulations.bp.pricing import arc_bounds, label_arc_bounds, nearest_ng
+    from sarcover.formulations.bp.arc_bounds import arc_bounds, label_arc_bounds
+    from sarcover.formulations.bp.ng_sets import nearest_ng
 
     cost, ret, profit, budget = _tiny_pricing(seed)
     n = cost.shape[0]
@@ -388,7 +399,7 @@ def test_label_arc_bounds_cover_every_path_above_the_threshold(seed, ng_size):
 def test_suffix_tables_are_the_best_walk_without_turning_back():
     """On integer arc costs with a one-unit grid the tables are exact: the best walk (points may
     repeat, no immediate return) within b units, enumerated."""
-    from sarcover.formulations.bp.pricing import _suffix_dp
+    from sarcover.formulations.bp.bounds import suffix_dp as _suffix_dp
 
     rng = np.random.default_rng(7)
     n = 6  # start, 4 nodes, end
@@ -418,9 +429,9 @@ def test_suffix_tables_are_the_best_walk_without_turning_back():
 def test_ng_route_columns_count_visits():
     """A repeated point counts twice in its node row (never integer-feasible); routes that stop
     being ng-routes when the ng sets grow are excluded from the master."""
+    from sarcover.formulations.bp.graph import NodeState
     from sarcover.formulations.bp.master import Master
-    from sarcover.formulations.bp.pricing import add_to_ng, nearest_ng
-    from sarcover.formulations.bp.node import NodeState
+    from sarcover.formulations.bp.ng_sets import add_to_ng, nearest_ng
 
     m = Master(4, np.ones(4), [(0, 1)], 2)
     m.add_routes([(1, 2, 3, 1), (1, 2), (3, 4)])
@@ -440,7 +451,7 @@ def test_branching_decisions_exclude_exactly_the_conflicting_routes():
     """Master.incompatible against its definition, route by route (repeated visits included):
     a route is out iff it visits a forbidden point, uses a forbidden arc, or leaves the tail of a
     forced arc (not the start) or enters its head (not the end) by another arc."""
-    from sarcover.formulations.bp.node import NodeState
+    from sarcover.formulations.bp.graph import NodeState
     from sarcover.formulations.bp.master import Master
 
     rng = np.random.default_rng(3)
@@ -481,7 +492,7 @@ def test_branching_decisions_exclude_exactly_the_conflicting_routes():
 def test_targeted_slack_keeps_the_floor(value, n):
     """The raised exact-pricing threshold: dual value + N * (slack + TOL) stays below the next
     integer (or incumbent + 1), so 'nothing found above the threshold' settles floor(bound)."""
-    from sarcover.formulations.bp.search import TOL
+    from sarcover.formulations.bp.constants import TOL
     from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = TOPInstance(coords=[[1, 0]], prizes=[1], start=[0, 0], end=[0, 0], budget=5.0, n_vehicles=n)
@@ -500,7 +511,7 @@ def test_dive_gives_a_verified_plan(seed):
     """The diving heuristic (root LP, then fixing routes) only returns plans the verifier accepts,
     never better than enumeration; on these tiny instances it finds the enumerated optimum
     whenever a plan exists."""
-    from sarcover.formulations.bp.node import NodeState
+    from sarcover.formulations.bp.graph import NodeState
     from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = random_tiny(seed, groups=True)
@@ -655,7 +666,7 @@ def test_milp_column_filter_keeps_every_better_plan(name):
     """The reduced-cost filter of the MILP's columns (duals that certified the root bound)
     never removes a better plan: with the incumbent set below the best plan over the generated
     routes, the filtered MILP finds a plan of that same value, from fewer routes."""
-    from sarcover.formulations.bp.node import NodeState
+    from sarcover.formulations.bp.graph import NodeState
     from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = _top(name)
@@ -665,7 +676,7 @@ def test_milp_column_filter_keeps_every_better_plan(name):
     assert bp.elimination.cert is not None
     full = m.milp(20.0)
     best = sum(m.route_prize[m.routes.index(r)] for r in full)
-    for below in (s.step, 2 * s.step, 4 * s.step):
+    for below in (s.problem.step, 2 * s.problem.step, 4 * s.problem.step):
         s.incumbent, s.incumbent_value = [], best - below
         keep = bp.elimination.milp_columns()
         assert keep is not None and keep.sum() <= m.n_routes
@@ -683,7 +694,7 @@ def test_strong_branching_proves_the_same_optimum():
     branched on, never the result: p3.3.o is proven at its published optimum either way, only
     the strong run pays for estimates, and the master's bounds are the node's again after them."""
     from sarcover.formulations.bp.branching import branch, branch_candidates
-    from sarcover.formulations.bp.node import NodeState
+    from sarcover.formulations.bp.graph import NodeState
     from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = _top("p3.3.o")
@@ -708,8 +719,8 @@ def test_group_bounds_set_the_group_rows():
     """A node's bounds on a group's visits become the group row's bounds (the cover row's lower
     bound 1 stays the floor), bind in the LP, count in the Lagrangian bound, and go when the
     master is set to a node without them."""
+    from sarcover.formulations.bp.graph import NodeState
     from sarcover.formulations.bp.master import Master
-    from sarcover.formulations.bp.node import NodeState
 
     m = Master(4, np.ones(4), [(0, 1, 2), (3,)], 4)  # group 0: points 1-3, group 1: point 4
     m.add_routes([(1,), (2,), (3,), (4,)])
@@ -755,7 +766,7 @@ def test_milp_start_plan_is_a_floor():
     """The MILP takes a plan as its first solution: with only that plan's routes allowed it
     returns that plan, under any time limit it returns nothing worse, and a start that is not
     made of generated routes is ignored (p2.2.k)."""
-    from sarcover.formulations.bp.node import NodeState
+    from sarcover.formulations.bp.graph import NodeState
     from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = _top("p2.2.k")
@@ -831,7 +842,8 @@ def test_exact_pricing_with_cuts_matches_enumeration(seed):
     """With subset-row cut duals, exact elementary labelling finds the best path's prize minus
     the duals of the cuts it pays (limited-memory coefficients, enumerated); every route it
     returns has the value it claims to beat; ng labelling stays an upper bound."""
-    from sarcover.formulations.bp.pricing import full_ng, nearest_ng, price
+    from sarcover.formulations.bp.labelling import price
+    from sarcover.formulations.bp.ng_sets import full_ng, nearest_ng
 
     cost, ret, profit, budget, (members, memory, sig), value, paths = _cut_priced(seed, 100 + seed)
     n = cost.shape[0]
@@ -866,9 +878,11 @@ def test_dominance_layout_changes_speed_not_labels(seed):
     the sub-buckets (default, and an odd count) create exactly the same labels: the same count,
     best value and routes, one-way and bidirectional, exact and heuristic; the most sub-buckets a
     label count may choose too."""
+    from sarcover.formulations.bp.graph import cheapest_return
+    from sarcover.formulations.bp.labelling import price, sub_buckets
+    from sarcover.formulations.bp.ng_sets import nearest_ng
     from sarcover.formulations.generate import generate
     from sarcover.formulations.instance import to_top
-    from sarcover.formulations.bp.pricing import cheapest_return, nearest_ng, price, sub_buckets
 
     inst = to_top(generate(20, 3, 5, seed))
     cost = inst.cost_matrix()
@@ -898,7 +912,12 @@ def test_sub_buckets_follow_the_expected_labels_per_point():
     """Without a label count the layout has NSUB sub-buckets per point; with one, about
     1.5·sqrt(labels per point) as a power of two within NSUB_RANGE, growing with the count, and
     never more than SUB_CELLS in all."""
-    from sarcover.formulations.bp.pricing import NSUB, NSUB_RANGE, SUB_CELLS, sub_buckets
+    from sarcover.formulations.bp.labelling import (
+        NSUB,
+        NSUB_RANGE,
+        SUB_CELLS,
+        sub_buckets,
+    )
 
     assert sub_buckets(62) == NSUB and sub_buckets(62, 0) == NSUB
     counts = [sub_buckets(62, labels) for labels in (100, 20_000, 100_000, 300_000, 10**8)]
@@ -913,7 +932,7 @@ def test_exact_pricing_is_laid_out_for_the_previous_exact_calls_labels(monkeypat
     """The search's exact calls pass the dominance layout sized by the previous exact call's
     label count (the first call, and every heuristic one, the default)."""
     import sarcover.formulations.bp.pricer as pricer_mod
-    from sarcover.formulations.bp.pricing import sub_buckets
+    from sarcover.formulations.bp.labelling import sub_buckets
     from sarcover.formulations.generate import generate
     from sarcover.formulations.instance import to_top
     from sarcover.formulations.result import Termination
@@ -1016,7 +1035,7 @@ def test_label_cap_under_cuts_withdraws_the_last_round_and_still_proves():
     withdraws the last round's cuts and tries no more rounds, instead of giving up the run (TOP
     set 5's p5.2.x stopped at 30 s of 600 that way). The cap is simulated on the first exact
     call after a cut round; p2.2.k's published optimum is still proven."""
-    from sarcover.formulations.bp.pricing import PricingResult
+    from sarcover.formulations.bp.labelling import PricingResult
     from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = load_instance(TOP_DIR / "p2.2.k.txt")
@@ -1091,10 +1110,11 @@ def test_cut_round_starts_only_if_it_would_end_within_the_share():
     class Reached(Exception):
         """The round went past the gate (to the arc elimination before its first cuts)."""
 
-    search = SimpleNamespace(incumbent=object(), incumbent_value=10.0, step=1.0,
+    search = SimpleNamespace(incumbent=object(), incumbent_value=10.0,
+                             problem=SimpleNamespace(step=1.0, floor=math.floor),
                              master=SimpleNamespace(n_routes=0),
-                             stats=SimpleNamespace(root_lp=None), time_left=lambda: 100.0,
-                             floor=math.floor)
+                             stats=SimpleNamespace(root_lp=None),
+                             clock=SimpleNamespace(time_left=lambda: 100.0))
     elimination = SimpleNamespace(version=0, eliminate=lambda labels: (_ for _ in ()).throw(Reached()))
     state = SimpleNamespace(depth=0)
 
@@ -1147,8 +1167,13 @@ def test_registered_bp_decides_cuts_on_the_users_limit(monkeypatch, offset, thre
     import sarcover.formulations.bp as bp_package
     import sarcover.formulations.bp.options as bp_options
     from sarcover.benchmarks.registry import METHODS
-    from sarcover.formulations.bp.options import (CUTS_FROM_S, OPEN_CUTS_FROM_S, default_cut_gap,
-                                                  default_cut_rounds, default_enum_labels)
+    from sarcover.formulations.bp.options import (
+        CUTS_FROM_S,
+        OPEN_CUTS_FROM_S,
+        default_cut_gap,
+        default_cut_rounds,
+        default_enum_labels,
+    )
     from sarcover.formulations.result import Result, Termination
 
     limit = getattr(bp_options, threshold) + offset
@@ -1270,7 +1295,7 @@ def _arcs_of_plans_from(inst: TOPInstance, value: float) -> set:
 def test_arc_elimination_keeps_every_better_plan(seed):
     """With the incumbent one step below the optimum, reduced-cost arc elimination after the
     root LP (DP and labelling bounds) removes arcs, but none of any optimal plan (enumerated)."""
-    from sarcover.formulations.bp.node import NodeState
+    from sarcover.formulations.bp.graph import NodeState
     from sarcover.formulations.bp.tree import BranchAndPrice
 
     inst = random_tiny(seed, groups=False)
@@ -1278,7 +1303,7 @@ def test_arc_elimination_keeps_every_better_plan(seed):
     bp = BranchAndPrice(inst, time_limit=None, options=BPOptions(strong=1))
     s = bp.search
     bp.incumbents.dived = True  # no dive: it could find the optimum and move the floor above it
-    s.incumbent, s.incumbent_value = [], best - s.step
+    s.incumbent, s.incumbent_value = [], best - s.problem.step
     bp.colgen.solve(NodeState(), math.inf)
     bp.elimination.eliminate(labels=True)
     gone = {(int(a), int(b)) for a, b in zip(*np.nonzero(s.master.eliminated))}
@@ -1334,7 +1359,7 @@ def test_root_out_of_time_right_after_the_route_pool_joined():
         eliminate(labels)
         if labels:
             pool_added.append(s.master.n_routes - before)
-            s.deadline = s.hard_deadline = time.perf_counter() - 1.0
+            s.clock.deadline = s.clock.hard_deadline = time.perf_counter() - 1.0
 
     bp.elimination.eliminate = out_of_time
     proven, bound = bp.run()
@@ -1348,8 +1373,8 @@ def test_enumeration_lists_every_route_above_the_threshold(seed, with_ng):
     """Route enumeration (cut duals paid, with and without the backward ng suffix table) lists
     one route per set of points for exactly the elementary routes whose best ordering's value
     beats the threshold (brute force)."""
-    from sarcover.formulations.bp.enumeration import enumerate_routes
-    from sarcover.formulations.bp.pricing import nearest_ng
+    from sarcover.formulations.bp.enumeration_kernel import enumerate_routes
+    from sarcover.formulations.bp.ng_sets import nearest_ng
 
     cost, _, profit, budget, (members, memory, sig), value, paths = _cut_priced(seed, 200 + seed)
     n = cost.shape[0]
@@ -1368,8 +1393,8 @@ def test_enumeration_lists_every_route_above_the_threshold(seed, with_ng):
 def test_enumeration_counts_what_a_narrower_listing_would_give(seed):
     """With a margin, a listing counts the routes a listing at threshold + margin gives (exactly:
     the sets whose best ordering clears it) and about its labels; its growth is their ratio."""
-    from sarcover.formulations.bp.enumeration import enumerate_routes
-    from sarcover.formulations.bp.pricing import nearest_ng
+    from sarcover.formulations.bp.enumeration_kernel import enumerate_routes
+    from sarcover.formulations.bp.ng_sets import nearest_ng
 
     cost, _, profit, budget, (members, memory, sig), _, paths = _cut_priced(seed, 300 + seed)
     n = cost.shape[0]

@@ -8,12 +8,11 @@ import dataclasses
 
 import numpy as np
 import pytest
-
 from sarcover.formulations.bp import BPOptions, solve_bp
-from sarcover.formulations.bp.enumerated_lp import EnumeratedLP, _cut_coefficients
-from sarcover.formulations.bp.enumeration import enumerate_routes
+from sarcover.formulations.bp.enumerated_lp import EnumeratedLP, cut_coefficients
+from sarcover.formulations.bp.enumeration_kernel import enumerate_routes
+from sarcover.formulations.bp.graph import NodeState, node_graph
 from sarcover.formulations.bp.master import _lm_coefficient
-from sarcover.formulations.bp.node import NodeState, node_graph
 from sarcover.formulations.bp.tree import BranchAndPrice
 from sarcover.formulations.generate import generate
 from sarcover.formulations.instance import to_top
@@ -40,10 +39,10 @@ def test_cut_coefficients_match_the_masters(seed):
     for c, (S, M) in enumerate(cuts):
         in_s[c, list(S)] = True
         in_m[c, list(set(M) | set(S))] = True
-    got = _cut_coefficients(paths, in_s, in_m)
+    got = cut_coefficients(paths, in_s, in_m)
     want = [[_lm_coefficient(r, S, set(M) | set(S)) for S, M in cuts] for r in routes]
     assert got.tolist() == want
-    full = _cut_coefficients(paths, in_s, np.ones_like(in_m))
+    full = cut_coefficients(paths, in_s, np.ones_like(in_m))
     assert full.tolist() == [[len(set(r) & set(S)) // 2 for S, _ in cuts] for r in routes]
 
 
@@ -53,7 +52,7 @@ def _all_routes(seed):
     bp = BranchAndPrice(inst, time_limit=30)
     s, m = bp.search, bp.search.master
     cost, _, allowed = node_graph(s, NodeState())
-    res = enumerate_routes(cost, m.point_profit(np.zeros(m.n_rows)), allowed, s.budget, -1.0)
+    res = enumerate_routes(cost, m.point_profit(np.zeros(m.n_rows)), allowed, s.problem.budget, -1.0)
     return inst, s, m, res.paths
 
 
@@ -73,9 +72,9 @@ def test_enumerated_lp_bounds_every_plan_and_its_filter_keeps_the_optimum(seed):
     bounds, cuts = [], 0
     for _ in range(6):
         out = lp.solve()
-        bounds.append(out.bound(s.N))
-        assert out.bound(s.N) >= opt - 1e-6
-        keep = out.rc >= out.floor(opt, s.N)
+        bounds.append(out.bound(s.problem.N))
+        assert out.bound(s.problem.N) >= opt - 1e-6
+        keep = out.rc >= out.floor(opt, s.problem.N)
         kept = {frozenset(lp.route(i)) for i in np.flatnonzero(keep)}
         assert {frozenset(r) for r in optimal_routes} <= kept
         new = lp.separate(out.x, 20)
@@ -155,7 +154,8 @@ def test_widening_is_guarded_by_the_growth_at_the_rim():
     """A narrow try that listed no better plan is widened by WIDEN steps only if its labels and
     routes, times their growth over the listing's rim (extrapolated geometrically to WIDEN
     steps when the listing is narrower), fit the caps."""
-    from sarcover.formulations.bp.enumeration import Enumerated, Enumeration
+    from sarcover.formulations.bp.enumeration import Enumeration
+    from sarcover.formulations.bp.enumeration_kernel import Enumerated
 
     res = Enumerated(np.zeros((100, 3), np.int32), n_labels=1000, inner_labels=250, inner_routes=50)
     assert res.growth() == (4.0, 2.0)
