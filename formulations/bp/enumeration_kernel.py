@@ -15,15 +15,14 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-from sarcover.formulations.bp._label_store import (extend, grow, new_store, next_label,
-                                                   store)
+from sarcover.formulations.bp._label_store import (extend, grow, grow_store, heap_push, new_store,
+                                                   next_label, out_of_time, write_label)
 from sarcover.formulations.bp.bounds import (DP_UNITS, completion_bound, completion_data, dp_bound,
                                              dp_unit, suffix_tables)
 from sarcover.formulations.bp.constants import EPS
 from sarcover.formulations.bp.cut_duals import cut_arrays, sigsum
 from sarcover.formulations.bp.graph import cheapest_return, reversed_graph
 from sarcover.formulations.bp.labelling import label_table
-from sarcover.formulations.bp.ng_sets import full_ng
 
 
 @njit(cache=True)
@@ -41,7 +40,7 @@ def _key_hash(w, mask):
 @njit(cache=True)
 def _enumerate(cost, ret, profit, budget, allowed, order, cin, reach, lastord, cend, threshold,
                max_labels, deadline, cmem, mmem, sig, g1, s1, g2, delta, nb, sfx, sdelta, snb,
-               margin, ng):
+               margin):
     """Labels of every elementary path start -> ... whose prize (after the cuts' duals) plus
     the completion and suffix bounds exceeds ``threshold``; a label is dropped only when a label
     at the same point with the same visited set has no more energy and no less prize (after
@@ -53,10 +52,9 @@ def _enumerate(cost, ret, profit, budget, allowed, order, cin, reach, lastord, c
     Labels with equal (point, set) form a list (``nxt``) whose head sits in an open-addressing
     table. Returns (count, node, pred, energy, prize, mask, alive, hit_cap, inner), ``inner``
     the labels made whose bounds also exceed ``threshold + margin`` (about the labels a listing
-    at that threshold would make). ``ng``: every point remembers every point (full visited
-    sets: :func:`.ng_sets.full_ng`)."""
+    at that threshold would make)."""
     n = cost.shape[0]
-    W = ng.shape[1]
+    W = (n + 63) // 64
     node, pred, en, pr, alive, mask, srb, hkey, hval = new_store(W)
     hn = 1
     nxt = np.empty(node.shape[0], np.int32)
@@ -75,10 +73,17 @@ def _enumerate(cost, ret, profit, budget, allowed, order, cin, reach, lastord, c
             break
         v = node[qi]
         for w in range(1, end):
-            fits, e2, p2, s2 = extend(qi, v, w, cost, ret, budget, profit, allowed, en, pr, mask,
-                                      srb, ng, cmem, mmem, sig, newmask)
+            wd = w >> 6
+            fits, e2, p2, paired, s2 = extend(en[qi], pr[qi], srb[qi], mask[qi, wd], w,
+                                              allowed[w], cost[v, w], ret[w], budget, profit[w],
+                                              mmem[w], cmem[w])
             if not fits:
                 continue
+            if paired:
+                p2 -= sigsum(paired, sig)
+            for k in range(W):
+                newmask[k] = mask[qi, k]
+            newmask[wd] |= np.uint64(1) << np.uint64(w & 63)
             ub = p2 + dp_bound(g1, s1, g2, w, v, budget - e2, delta, nb)
             if ub <= threshold:
                 continue
@@ -120,14 +125,14 @@ def _enumerate(cost, ret, profit, budget, allowed, order, cin, reach, lastord, c
                 j = nxt[j]
             if dominated:
                 continue
-            stored, node, pred, en, pr, alive, mask, srb, hkey, hval, hn = store(
-                node, pred, en, pr, alive, mask, srb, hkey, hval, hn, count, w, qi, e2, p2, s2,
-                newmask, max_labels, deadline)
-            hit = not stored
-            if hit:
+            if count == max_labels or ((count & 4095) == 0 and out_of_time(deadline)):
+                hit = True
                 break
-            if nxt.shape[0] < node.shape[0]:
+            if count == node.shape[0]:
+                node, pred, en, pr, alive, mask, srb, hkey, hval = grow_store(
+                    node, pred, en, pr, alive, mask, srb, hkey, hval)
                 nxt = grow(nxt, node.shape[0])
+            write_label(node, pred, en, pr, alive, mask, srb, count, w, qi, e2, p2, s2, newmask)
             inner += ub > threshold + margin
             nxt[count] = head
             table[slot] = count
@@ -145,6 +150,7 @@ def _enumerate(cost, ret, profit, budget, allowed, order, cin, reach, lastord, c
                             t0 = (t0 + 1) & (tsize - 1)
                         new[t0] = h0
                     table = new
+            hn = heap_push(hkey, hval, hn, e2, count)
             count += 1
         if hit:
             break
@@ -216,8 +222,7 @@ def enumerate_routes(cost, profit, allowed, budget, threshold, *, ng=None, cut_m
     count, node, pred, en, pr, mask, _, hit, inner = _enumerate(
         cost, ret, profit, float(budget), allowed, order, cin, reach, lastord, cend,
         float(threshold), int(max_labels), float(deadline), cmem, mmem, sig,
-        *suffix_tables(cost, profit, allowed, budget), sfx, float(sdelta), int(snb), float(margin),
-        full_ng(n))
+        *suffix_tables(cost, profit, allowed, budget), sfx, float(sdelta), int(snb), float(margin))
     if hit:
         return Enumerated(None, int(count))
     end = n - 1

@@ -54,8 +54,9 @@ import math
 
 import numpy as np
 from numba import njit
-from sarcover.formulations.bp._label_store import (chain, extend, grow, new_store,
-                                                   next_label, store)
+from sarcover.formulations.bp._label_store import (chain, extend, grow, grow_store, heap_push,
+                                                   new_store, next_label, out_of_time,
+                                                   write_label)
 from sarcover.formulations.bp.bounds import (completion_bound, completion_data, dp_bound,
                                              suffix_tables)
 from sarcover.formulations.bp.constants import EPS
@@ -154,10 +155,17 @@ def label_search(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, 
                                      profit, cin, reach, lastord, cend) <= threshold:
             continue
         for w in range(1, end):
-            fits, e2, p2, s2 = extend(qi, v, w, cost, ret, budget, profit, allowed, en, pr, mask,
-                                      srb, ng, cmem, mmem, sig, newmask)
+            wd = w >> 6
+            fits, e2, p2, paired, s2 = extend(en[qi], pr[qi], srb[qi], mask[qi, wd], w,
+                                              allowed[w], cost[v, w], ret[w], budget, profit[w],
+                                              mmem[w], cmem[w])
             if not fits:
                 continue
+            if paired:
+                p2 -= sigsum(paired, sig)
+            for k in range(W):
+                newmask[k] = mask[qi, k] & ng[w, k]  # remembered at w: its ng set, and w
+            newmask[wd] |= np.uint64(1) << np.uint64(w & 63)
             if p2 + dp_bound(g1, s1, g2, w, v, budget - e2, delta, nb) <= threshold:
                 continue
             if p2 + completion_bound(newmask, w, budget - e2, threshold - p2, order, profit, cin,
@@ -235,12 +243,14 @@ def label_search(cost, ret, profit, budget, ng, allowed, heuristic, max_labels, 
                                     wm[i, k] = wm[i + 1, k]
                     j -= 1
                 bcnt[bx] = cw
-            stored, node, pred, en, pr, alive, mask, srb, hkey, hval, hn = store(
-                node, pred, en, pr, alive, mask, srb, hkey, hval, hn, count, w, qi, e2, p2, s2,
-                newmask, max_labels, deadline)
-            hit = not stored
-            if hit:
+            if count == max_labels or ((count & 4095) == 0 and out_of_time(deadline)):
+                hit = True
                 break
+            if count == node.shape[0]:
+                node, pred, en, pr, alive, mask, srb, hkey, hval = grow_store(
+                    node, pred, en, pr, alive, mask, srb, hkey, hval)
+            write_label(node, pred, en, pr, alive, mask, srb, count, w, qi, e2, p2, s2, newmask)
+            hn = heap_push(hkey, hval, hn, e2, count)
             if not heuristic and p2 > threshold and e2 + cost[w, end] <= budget:
                 # exact mode looks for the best path: prune against (nearly) the best found
                 t2 = p2 - keep * (p2 - start)
