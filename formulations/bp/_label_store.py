@@ -6,12 +6,10 @@ energy, their extension by one arc, the deadline poll and the arrays' growth.
 Label 0 is the root: the start (point 0), no energy, no prize. Sets are bitsets of ``W`` 64-bit
 words.
 
-The searches call these in their innermost loops, so they take what costs no time to pass:
-:func:`extend`, called once per arc, takes scalars only (passing it the arrays, even with numba's
-``inline="always"``, made the labelling about 15 % slower on p1.3.n and p3.4.k, the same labels
-made); the per-label functions return no arrays (storing through one that returned the store's
-arrays, or inlining them, cost 40-50 %). As they are, the searches run as fast as before the
-store was shared.
+The searches call these in their innermost loops, so they pass what costs nothing to pass:
+:func:`extend`, called once per arc, takes scalars only, and the per-label functions return no
+arrays; arrays passed per arc, or returned per label, slow the searches down measurably
+(docs/bp-log.md, 2026-12-05, the label store).
 """
 
 from __future__ import annotations
@@ -142,7 +140,7 @@ def extend(e, p, parities, word, w, allowed_w, c, ret_w, budget, prize_w, mmem_w
     remembered set (``word``: the set's 64-bit word that holds w). The prize gains ``prize_w``;
     the caller pays the duals of the cuts paired (those whose triple, ``cmem_w``, holds w and
     whose parity was odd), and a cut's parity is forgotten outside its memory (``mmem_w``).
-    Scalars only: called once per arc, a function that takes arrays costs the searches 15 %."""
+    Scalars only: it is called once per arc."""
     if not allowed_w:
         return False, e, p, np.uint64(0), np.uint64(0)
     e2 = e + c
