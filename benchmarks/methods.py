@@ -308,8 +308,6 @@ def compile_routers() -> None:
 
 
 def compile_bp() -> None:
-    from sarcover.formulations.bp.pricing import (
-        warm_up,  # to become `from sarcover.formulations.bp import warm_up`
-    )
+    from sarcover.formulations.bp import warm_up
 
     warm_up()

@@ -14,7 +14,9 @@ import numpy as np
 import pytest
 
 from sarcover.formulations.bp import solve_bp
-from sarcover.formulations.bp.pricing import cheapest_return, full_ng, nearest_ng, price
+from sarcover.formulations.bp.graph import cheapest_return
+from sarcover.formulations.bp.labelling import price
+from sarcover.formulations.bp.ng_sets import full_ng, nearest_ng
 from sarcover.formulations.io import read_top
 from sarcover.formulations.result import Status
 

@@ -7,8 +7,8 @@ import math
 import time
 from dataclasses import asdict
 
+from sarcover.formulations.bp.compile import warm_up
 from sarcover.formulations.bp.options import BPOptions
-from sarcover.formulations.bp.pricing import warm_up
 from sarcover.formulations.bp.tree import BranchAndPrice
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan

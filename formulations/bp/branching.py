@@ -7,7 +7,7 @@ integral (each positive route follows the unique flow-1 arcs); a node where that
 
 A group's visits can split the LP more evenly than one of its points: the LP spreads a target's
 views over several viewpoints, and forcing or forbidding one leaves the others to make up for it.
-On the M = 20 SAR instances it proved no more (docs/bp.md), so it is off by default.
+On the M = 20 SAR instances it proved no more (docs/bp-log.md), so it is off by default.
 
 Strong branching picks among the ``strong`` most fractional candidates the one whose two
 children, re-solved on the current columns without pricing (a cheap estimate), drop most below
@@ -20,9 +20,8 @@ import time
 from typing import TYPE_CHECKING
 
 import numpy as np
-
-from sarcover.formulations.bp.node import NodeState
-from sarcover.formulations.bp.search import TOL
+from sarcover.formulations.bp.constants import TOL
+from sarcover.formulations.bp.graph import NodeState
 
 if TYPE_CHECKING:
     from sarcover.formulations.bp.search import Search
@@ -44,7 +43,7 @@ def branch_candidates(search: "Search", state: NodeState, x: np.ndarray,
         pairs += [[state.child(group_bounds=[(int(g), -np.inf, float(np.floor(gv[g])))]),
                    state.child(group_bounds=[(int(g), float(np.ceil(gv[g])), np.inf)])]
                   for g in gs]
-    visits = m.node_visits(x)[1 : search.V + 1]
+    visits = m.node_visits(x)[1 : search.problem.V + 1]
     frac = np.abs(visits - np.round(visits))
     pts = np.flatnonzero(frac > TOL)
     if pts.size or pairs:

@@ -19,43 +19,61 @@ Each round solves the restricted master LP and prices:
    the master, and column generation goes on with the stronger relaxation; only within the first
    ``grow_share`` of the time limit, since larger ng sets make pricing slower.
 
-At the root, once the floored bound is settled, the first dive (and if needed the caller's
-heuristic) runs before the ng sets grow, and the cut rounds (:mod:`.cuts`) come last.
+At the root, column generation takes the root's own steps (:class:`RootSteps`, the policy in
+:mod:`.root`): the caller's heuristic when the root is slow to settle, the certificate of every
+exact bound, the first dive once the floored bound is settled (before the ng sets grow), the
+cut rounds last, and their withdrawal when an exact pricing under them hits its label cap.
 """
 
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
-
-from sarcover.formulations.bp.node import NodeState, node_graph
-from sarcover.formulations.bp.pricing import add_to_ng
-from sarcover.formulations.bp.search import TOL
+from sarcover.formulations.bp.constants import TOL
+from sarcover.formulations.bp.graph import NodeState, node_graph
+from sarcover.formulations.bp.ng_sets import add_to_ng
 
 if TYPE_CHECKING:
-    from sarcover.formulations.bp.cuts import CutRounds
     from sarcover.formulations.bp.elimination import Elimination
-    from sarcover.formulations.bp.incumbent import IncumbentSearch
     from sarcover.formulations.bp.pricer import Pricer
     from sarcover.formulations.bp.search import Search
 
 
+class RootSteps(Protocol):
+    """What column generation asks of the root's policy (:class:`.root.Root`), at the root only."""
+
+    def slow_to_settle(self) -> bool:
+        """Before an exact pricing: whether a plan was sought because the root is slow to settle
+        (the LP is then re-solved with its routes)."""
+
+    def certified(self, y, y0: float, best: float, lagrangian: float, bound: float) -> None:
+        """An exact pricing certified ``lagrangian`` from duals ``y``; the root's ``bound``."""
+
+    def label_cap(self) -> bool:
+        """An exact pricing hit its label cap: whether the LP changed so that it can go on."""
+
+    def settled(self, state: NodeState, bound: float) -> bool:
+        """The floored bound is settled: whether plans were sought (the LP is then re-solved)."""
+
+    def add_cuts(self, state: NodeState, x, y, lp_value: float) -> bool:
+        """The LP is converged: whether cuts (or the graph) changed it."""
+
+
 class ColumnGeneration:
     """Solves nodes' LPs for one run (:meth:`solve`); ng sets grow up to ``ng_cap`` points until
-    ``grow_until`` (a :func:`time.perf_counter` moment)."""
+    ``grow_until`` (a :func:`time.perf_counter` moment). ``root``: the root's steps (set once
+    the root's policy exists)."""
 
-    def __init__(self, search: "Search", pricer: "Pricer", elimination: "Elimination",
-                 incumbents: "IncumbentSearch", cuts: "CutRounds", *, ng_cap: int,
-                 grow_until: float):
+    def __init__(self, search: "Search", pricer: "Pricer", elimination: "Elimination", *,
+                 ng_cap: int, grow_until: float):
         self.search = search
         self.pricer = pricer
         self.elimination = elimination
-        self.incumbents = incumbents
-        self.cuts = cuts
         self.ng_cap = ng_cap
         self.grow_until = grow_until
+        self.root: RootSteps | None = None
 
     def solve(self, state: NodeState, bound: float):
         """Solve one node's LP by column generation, starting from the parent's ``bound``.
@@ -63,6 +81,7 @@ class ColumnGeneration:
         hit its label cap (at the root first without the last cut round, see
         :meth:`.cuts.CutRounds.withdraw`)."""
         s, m, pricer, elim = self.search, self.search.master, self.pricer, self.elimination
+        root = self.root if state.depth == 0 else None
         version = None
         arcs_decided = bool(state.forbidden_arcs or state.forced_arcs)
         x = xa = None
@@ -76,7 +95,7 @@ class ColumnGeneration:
             value, x, xa, y = m.solve()
             s.stats.lp_s += time.perf_counter() - t
             s.stats.rounds += 1
-            if s.time_left() <= 0:
+            if s.clock.time_left() <= 0:
                 return bound, x, xa, False
             prof = m.point_profit(y)
             sig = m.cut_duals(y)
@@ -88,31 +107,27 @@ class ColumnGeneration:
             res = pricer.price(cost, ret, prof, allowed, heuristic=True, y0=y0, sig=sig)
             if m.add_routes(pricer.columns(res)):
                 continue
-            if s.time_left() <= 0:
+            if s.clock.time_left() <= 0:
                 return bound, x, xa, False
-            if (state.depth == 0 and not s.stats.primal_calls and not self.incumbents.dived
-                    and time.perf_counter() > s.until(s.options.primal_late_share)
-                    and self.incumbents.call_primal()):
-                continue  # the root is slow to settle: a plan now, its routes in the LP
-            gain = y0 + (self.slack(m.lagrangian_bound(y, y0)) if state.depth else 0.0)
+            if root is not None and root.slow_to_settle():
+                continue  # a plan now, its routes in the LP
+            # below the root the exact pricing is targeted; the root's LP is converged
+            gain = y0 + (self.slack(m.lagrangian_bound(y, y0)) if root is None else 0.0)
             res = pricer.exact(cost, ret, prof, allowed, gain, sig)
             s.stats.exact_pricings += 1
-            if not res.exact and s.time_left() > 0:
+            if not res.exact and s.clock.time_left() > 0:
                 # the label cap, not the clock: no bound from this call. Under the last cut
                 # round's cuts, withdraw them and go on; otherwise the node stays unconverged
                 s.stats.label_caps += 1
                 m.add_routes(pricer.columns(res))
-                if state.depth == 0 and self.cuts.withdraw():
+                if root is not None and root.label_cap():
                     continue
                 return bound, x, xa, False
             if res.exact:
                 lag = m.lagrangian_bound(y, res.best)
-                if state.depth == 0:
-                    # duals that certify the root bound: they eliminate arcs and MILP columns
-                    elim.root_duals(y, y0, res.best, lag)
                 bound = min(bound, lag)
-                if state.depth == 0:
-                    s.log(bound)
+                if root is not None:
+                    root.certified(y, y0, res.best, lag, bound)
                 if s.prunable(bound):
                     return bound, x, xa, True  # pruned (at the root: proven) before convergence
             if m.add_routes(pricer.columns(res)):
@@ -126,44 +141,29 @@ class ColumnGeneration:
                 continue
             if not res.exact:
                 return bound, x, xa, False
-            if state.depth == 0 and not self.incumbents.dived and s.time_left() > 0:
-                # the root's floored bound is settled: find a plan before growing ng sets
-                # (which only pays when the incumbent is below the floored bound)
-                self._first_dive(state, bound)
+            if root is not None and root.settled(state, bound):
                 if s.prunable(bound):
                     return bound, x, xa, True
                 continue  # re-solve with the heuristic's and the dive's columns
             if self._grow_ng_from_lp(x):
                 m.apply(state)
                 continue
-            if self.cuts.add(state, x, y, value):
+            if root is not None and root.add_cuts(state, x, y, value):
                 continue
             return bound, x, xa, True
-
-    def _first_dive(self, state: NodeState, bound: float) -> None:
-        """The root's first dive; if it leaves the proof open, the caller's heuristic, and a
-        second dive over its columns. Leaves the master at the root node."""
-        s, inc = self.search, self.incumbents
-        inc.dived = True
-        inc.dive(min(inc.dive_limit, 0.5 * s.time_left()))
-        if not s.prunable(bound) and inc.call_primal():
-            if not s.prunable(bound):  # dive again, now with the heuristic's columns
-                s.master.apply(state)  # (its LP differs: any start route, even the first's)
-                inc.dive(min(inc.dive_limit, 0.5 * s.time_left()), fresh=True)
-        s.master.apply(state)
 
     def slack(self, dual_value: float) -> float:
         """Targeted pricing: how much the best route's reduced prize may exceed the vehicle dual
         while dual_value + N·excess stays below the next value that matters: the next lattice
         point above dual_value, or incumbent + step if higher (integer prizes only)."""
         s = self.search
-        if not s.integral:
+        if not s.problem.integral:
             return 0.0
-        target = s.floor(dual_value) + s.step
+        target = s.problem.floor(dual_value) + s.problem.step
         if s.incumbent is not None:
-            target = max(target, s.incumbent_value + s.step)
+            target = max(target, s.incumbent_value + s.problem.step)
         # reported best >= y0 + slack + TOL, so keep N·TOL and the floor's 1e-6 below target
-        return max(0.0, (target - dual_value - 2e-6) / s.N - 2 * TOL)
+        return max(0.0, (target - dual_value - 2e-6) / s.problem.N - 2 * TOL)
 
     def _grow_ng_from_lp(self, x) -> bool:
         """Dynamic ng sets: for every repeated route in the LP solution, remember the repeated

@@ -24,8 +24,8 @@ from __future__ import annotations
 import time
 from typing import TYPE_CHECKING
 
+from sarcover.formulations.bp.graph import NodeState
 from sarcover.formulations.bp.master import MAX_CUTS
-from sarcover.formulations.bp.node import NodeState
 
 if TYPE_CHECKING:
     from sarcover.formulations.bp.elimination import Elimination
@@ -58,7 +58,7 @@ class CutRounds:
         changed by the labelling arc bounds run before the first round), so that it is
         re-solved."""
         s = self.search
-        if state.depth > 0 or self.done >= self.rounds or s.time_left() <= 0:
+        if state.depth > 0 or self.done >= self.rounds or s.clock.time_left() <= 0:
             return False
         now = time.perf_counter()
         if s.incumbent is None or now > self.until:
@@ -68,8 +68,8 @@ class CutRounds:
         if s.stats.root_lp is None:
             s.stats.root_lp = lp_value
         # the drop that proves the incumbent optimal, or lowers the floored bound by one step
-        need = min(lp_value - (s.incumbent_value + s.step), lp_value - s.floor(lp_value))
-        if need > self.gap * s.step:
+        need = min(lp_value - (s.incumbent_value + s.problem.step), lp_value - s.problem.floor(lp_value))
+        if need > self.gap * s.problem.step:
             return False
         if not self.labelled:
             # the labelling arc bounds first: cut rounds then price on the smaller graph

@@ -16,9 +16,8 @@ import time
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
-
-from sarcover.formulations.bp.node import NodeState, node_graph
-from sarcover.formulations.bp.pricing import arc_bounds, label_arc_bounds
+from sarcover.formulations.bp.arc_bounds import arc_bounds, label_arc_bounds
+from sarcover.formulations.bp.graph import NodeState, node_graph
 
 if TYPE_CHECKING:
     from sarcover.formulations.bp.search import Search
@@ -67,8 +66,8 @@ class Elimination:
         s = self.search
         if self.cert is None or s.incumbent is None:
             return None
-        need = s.incumbent_value + (s.step if s.integral else 1e-9)
-        return need - self.cert.dual_term - (s.N - 1) * self.cert.rc_star - 1e-6
+        need = s.incumbent_value + (s.problem.step if s.problem.integral else 1e-9)
+        return need - self.cert.dual_term - (s.problem.N - 1) * self.cert.rc_star - 1e-6
 
     def milp_columns(self):
         """(n_routes,) bool: the routes that can be part of a plan better than the incumbent.
@@ -83,9 +82,9 @@ class Elimination:
         leaves the pricing graph and the LP of every node (and every later plan search) for
         good. Re-checked when the incumbent improves or the root's certificate gets tighter.
 
-        The arc bounds are computed once per certificate: :func:`.pricing.arc_bounds` (a
+        The arc bounds are computed once per certificate: :func:`.arc_bounds.arc_bounds` (a
         2-cycle-free DP over energy units, milliseconds) always; with ``labels`` (once the root
-        is solved) also :func:`.pricing.label_arc_bounds` on the arcs the DP leaves (exact
+        is solved) also :func:`.arc_bounds.label_arc_bounds` on the arcs the DP leaves (exact
         ng-labelling both ways, about as costly as two exact pricing calls, much tighter). The
         labelling bound only covers the paths above its threshold, so it stays valid as the
         incumbent, and with it the floor, rises. Its forward search also yields the
@@ -101,11 +100,11 @@ class Elimination:
             y = self.cert.duals
             cost, _, allowed = node_graph(s, NodeState())
             prof = s.master.point_profit(y)
-            through = self._arc_cert[1] if cached else arc_bounds(cost, prof, allowed, s.budget)
+            through = self._arc_cert[1] if cached else arc_bounds(cost, prof, allowed, s.problem.budget)
             if labels:
                 cost[through - y[0] < floor] = np.inf
-                exact = label_arc_bounds(cost, prof, allowed, s.budget, s.ng, y[0] + floor,
-                                         deadline=min(s.deadline, t + self.elim_limit),
+                exact = label_arc_bounds(cost, prof, allowed, s.problem.budget, s.ng, y[0] + floor,
+                                         deadline=min(s.clock.deadline, t + self.elim_limit),
                                          n_routes=self.pool_routes)
                 if exact is not None:
                     through = np.minimum(through, exact[0])
@@ -116,7 +115,7 @@ class Elimination:
             self._arc_cert = (self.cert, through, labels)
         m = s.master
         y0 = self.cert.duals[0]
-        new = (self._arc_cert[1] - y0 < floor) & ~m.eliminated & np.isfinite(s.cost)
+        new = (self._arc_cert[1] - y0 < floor) & ~m.eliminated & np.isfinite(s.problem.cost)
         new[:, 0] = new[-1, :] = False
         np.fill_diagonal(new, False)
         if new.any():

@@ -6,7 +6,7 @@ may use, pricing is inspection: every route's reduced prize is one sparse produc
 then costs an LP row and nothing in any labelling, so triples are separated with full memory
 (coefficient floor(visits to S / 2)) as many as the LP asks for: on M = 20, K = 5 the root needs
 hundreds of them to lose its last unit, far beyond the 64 that the labelling carries
-(docs/bp.md). The master's own (limited-memory) cuts are rows too, so the LP starts at most at
+(docs/bp-log.md). The master's own (limited-memory) cuts are rows too, so the LP starts at most at
 the root certificate's bound.
 
 After every round the routes are filtered by reduced cost: under optimal duals y of the LP over
@@ -25,12 +25,12 @@ import highspy
 import numpy as np
 import scipy.sparse as sp
 from numba import njit
-
-from sarcover.formulations.bp.master import INF, packing_milp, quiet_highs, spread, violated_triples
+from sarcover.formulations.bp.highs import INF, packing_milp, quiet_highs
+from sarcover.formulations.bp.master import spread, violated_triples
 
 
 @njit(cache=True)
-def _cut_coefficients(paths, in_s, in_m):
+def cut_coefficients(paths, in_s, in_m):
     """(routes, cuts) limited-memory subset-row coefficients: along each route (rows of solver
     points padded with -1), pairs of visits to cut c's points ``in_s[c]``, an unpaired visit
     forgotten at a point outside its memory ``in_m[c]`` (all True: full memory)."""
@@ -53,12 +53,6 @@ def _cut_coefficients(paths, in_s, in_m):
                     odd = not odd
             out[r, c] = pairs
     return out
-
-
-def warm_up() -> None:
-    """Compile (or load from numba's cache) the coefficient kernel."""
-    _cut_coefficients(np.array([[1, 2, -1]], np.int32), np.ones((1, 4), np.bool_),
-                      np.ones((1, 4), np.bool_))
 
 
 class Solved(NamedTuple):
@@ -136,7 +130,7 @@ class EnumeratedLP:
             if M is not None:
                 in_m[c] = False
                 in_m[c, list(M)] = True
-        coef = sp.csr_matrix(_cut_coefficients(self.paths, in_s, in_m).astype(np.float64))
+        coef = sp.csr_matrix(cut_coefficients(self.paths, in_s, in_m).astype(np.float64))
         self.cut_matrix = sp.hstack([self.cut_matrix, coef], format="csr")
         self.cuts.extend(cuts)
         self.h = None  # rebuilt on the next solve (rows over all columns)

@@ -13,9 +13,8 @@ import time
 from typing import TYPE_CHECKING
 
 import numpy as np
-
-from sarcover.formulations.bp.node import NodeState, node_graph
-from sarcover.formulations.bp.search import TOL
+from sarcover.formulations.bp.constants import TOL
+from sarcover.formulations.bp.graph import NodeState, node_graph
 from sarcover.formulations.plan import Plan
 from sarcover.formulations.verify import verify
 
@@ -47,10 +46,10 @@ class IncumbentSearch:
         (a better incumbent eliminates more arcs). Returns the verifier's report (None for no
         plan or more than N routes)."""
         s = self.search
-        if routes is None or len(routes) > s.N:
+        if routes is None or len(routes) > s.problem.N:
             return None
         plan = Plan.of([[p - 1 for p in r] for r in routes])
-        rep = verify(s.inst, plan)
+        rep = verify(s.problem.inst, plan)
         if rep.valid and rep.prize > s.incumbent_value + 1e-9:
             s.incumbent_value = rep.prize
             s.incumbent = list(routes)
@@ -71,7 +70,7 @@ class IncumbentSearch:
         ``limit`` seconds, over the routes that can be part of a better plan."""
         s = self.search
         s.stats.milp_calls += 1
-        limit = min(limit, max(0.0, s.hard_deadline - time.perf_counter() - 0.1))
+        limit = min(limit, max(0.0, s.clock.hard_deadline - time.perf_counter() - 0.1))
         if limit > 0.05:
             t, before = time.perf_counter(), s.incumbent_value
             allowed = self.elimination.milp_columns()
@@ -94,11 +93,11 @@ class IncumbentSearch:
         ``primal_late_share`` of the limit (a heuristic may return another plan when called
         again: the registered bp's PyVRP then searches with a new seed until its time is up)."""
         s = self.search
-        if self.primal is None or s.time_left() <= 0 or s.stats.primal_calls >= s.options.primal_calls:
+        if self.primal is None or s.clock.time_left() <= 0 or s.stats.primal_calls >= s.options.primal_calls:
             return False
         s.stats.primal_calls += 1
         t = time.perf_counter()
-        allowance = min(self.primal_limit, 0.5 * s.time_left())
+        allowance = min(self.primal_limit, 0.5 * s.clock.time_left())
         try:
             routes = self.primal(allowance)
         except Exception as exc:  # a failing heuristic must not cost the proof search
@@ -113,7 +112,7 @@ class IncumbentSearch:
         if rep is not None and rep.valid:
             s.stats.primal_prize = max(float(rep.prize), s.stats.primal_prize or -np.inf)
         s.stats.primal_improved = bool(s.stats.primal_improved) or s.incumbent_value > before
-        s.master.add_routes([r for r in pts if s.energy(r) <= s.budget])
+        s.master.add_routes([r for r in pts if s.problem.energy(r) <= s.problem.budget])
         return True
 
     def dive(self, limit: float, start: NodeState | None = None, *, fresh: bool = False) -> None:
@@ -138,7 +137,7 @@ class IncumbentSearch:
     def _dive(self, limit: float, start: NodeState | None, fresh: bool) -> None:
         s = self.search
         m = s.master
-        stop = min(s.deadline, time.perf_counter() + limit)
+        stop = min(s.clock.deadline, time.perf_counter() + limit)
         state, parent = (start or NodeState()), None
         used: set[int] = set()  # routes fixed or tried: never picked again
         failures = 0
@@ -173,6 +172,6 @@ class IncumbentSearch:
             if not used:
                 self.dive_starts.add(r)
             used.add(r)
-            full = [0, *m.routes[r], s.V + 1]
+            full = [0, *m.routes[r], s.problem.V + 1]
             parent = state
             state = state.child(forced_nodes=m.routes[r], forced_arcs=list(zip(full, full[1:])))

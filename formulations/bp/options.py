@@ -82,7 +82,7 @@ class BPOptions:
       visit counts), so that the LP stays the relaxation that the pricing bounds.
     - ``exact_keep``: exact pricing keeps the routes within this share of the best route's gain
       (over the vehicle dual) below it, instead of pruning against the best itself: more
-      columns per call, more labels (:func:`.pricing.price`); 0 prunes against the best, 1
+      columns per call, more labels (:func:`.labelling.price`); 0 prunes against the best, 1
       never raises the threshold. 0.5: fewer exact calls at the root, more cut rounds in time
       (docs/bp.md).
     - ``ng_cap``: the most points an ng set grows to when LP routes repeat a point.

@@ -1,4 +1,4 @@
-"""The labelling (:func:`.pricing.price`) as the search calls it: heuristic or exact, against a
+"""The labelling (:func:`.labelling.price`) as the search calls it: heuristic or exact, against a
 threshold, with the subset-row cuts' duals, timed and counted; and the choice of the exact
 pricing's direction."""
 
@@ -7,8 +7,8 @@ from __future__ import annotations
 import time
 from typing import TYPE_CHECKING
 
-from sarcover.formulations.bp.pricing import price, sub_buckets
-from sarcover.formulations.bp.search import TOL
+from sarcover.formulations.bp.constants import TOL
+from sarcover.formulations.bp.labelling import price, sub_buckets
 
 if TYPE_CHECKING:
     from sarcover.formulations.bp.search import Search
@@ -17,7 +17,7 @@ if TYPE_CHECKING:
 class Pricer:
     """Pricing calls of one run. ``bidirectional``: the exact pricing direction; None until the
     first exact call has measured both. ``keep``: the exact calls' share of near-best routes
-    (:func:`.pricing.price`); ``exact_labels``: their label cap."""
+    (:func:`.labelling.price`); ``exact_labels``: their label cap."""
 
     def __init__(self, search: "Search", bidirectional: bool | None, ng_columns: bool,
                  keep: float, exact_labels: int):
@@ -30,17 +30,17 @@ class Pricer:
 
     def price(self, cost, ret, prof, allowed, *, heuristic: bool, y0: float, sig,
               deadline: float | None = None):
-        """One labelling call on a node's graph (:func:`.node.node_graph`) with reduced prizes
+        """One labelling call on a node's graph (:func:`.graph.node_graph`) with reduced prizes
         ``prof``; ``y0`` is the threshold a path's reduced prize must beat (the vehicle dual, or
         more for a targeted exact call); ``sig``: the subset-row cuts' duals."""
         s = self.search
         t = time.perf_counter()
         # an exact call makes about as many labels as the one before it: its sub-buckets follow
         nsub = None if heuristic else sub_buckets(cost.shape[0], self.last_exact_labels)
-        res = price(cost, ret, prof, s.budget, s.ng, allowed, heuristic=heuristic,
+        res = price(cost, ret, prof, s.problem.budget, s.ng, allowed, heuristic=heuristic,
                     max_labels=200_000 if heuristic else self.exact_labels,
                     n_cols=30 if heuristic else 60, min_gain=y0 + TOL,
-                    deadline=s.deadline if deadline is None else deadline,
+                    deadline=s.clock.deadline if deadline is None else deadline,
                     bidirectional=bool(self.bidirectional) and not heuristic,
                     cut_members=s.master.cut_members, cut_memory=s.master.cut_memory,
                     cut_duals=sig, keep=0.0 if heuristic else self.keep, nsub=nsub)
@@ -62,7 +62,7 @@ class Pricer:
         t_uni = time.perf_counter() - t
         if not uni.exact:
             return uni
-        deadline = min(self.search.deadline, time.perf_counter() + 0.8 * t_uni)
+        deadline = min(self.search.clock.deadline, time.perf_counter() + 0.8 * t_uni)
         t = time.perf_counter()
         self.bidirectional = True
         bi = self.price(cost, ret, prof, allowed, heuristic=False, y0=y0, sig=sig,

@@ -3,10 +3,10 @@ first and reports what it proved.
 
 Nodes are explored best floored bound first, deepest first among equals (depth first until a
 plan of the best floored value turns up); a node is pruned when its floored bound does not exceed
-the incumbent. The root gets more than the other nodes: once its LP is solved, the labelling arc
-bounds (and the root again if they remove arcs), a dive from its final LP and a MILP over the
-generated routes; later nodes get a dive every ``dive_every`` nodes and a MILP every
-``milp_every`` nodes. The reported bound is max(incumbent, floored bounds of the open nodes),
+the incumbent. The root gets more than the other nodes (its policy: :mod:`.root`), and a MILP
+over the generated routes once it is solved; later nodes get a dive every ``dive_every`` nodes
+and a MILP every ``milp_every`` nodes, and before each, route enumeration under the root's
+certificate (:mod:`.enumeration`) is tried when the certificate or the incumbent has changed. The reported bound is max(incumbent, floored bounds of the open nodes),
 certified at every stop; a run whose open nodes all floor to the incumbent is proven.
 """
 
@@ -17,17 +17,18 @@ import math
 import time
 
 import numpy as np
-
 from sarcover.formulations.bp.branching import branch
 from sarcover.formulations.bp.colgen import ColumnGeneration
+from sarcover.formulations.bp.constants import TOL
 from sarcover.formulations.bp.cuts import CutRounds
 from sarcover.formulations.bp.elimination import Elimination
 from sarcover.formulations.bp.enumeration import Enumeration
+from sarcover.formulations.bp.graph import NodeState
 from sarcover.formulations.bp.incumbent import IncumbentSearch
-from sarcover.formulations.bp.node import NodeState
 from sarcover.formulations.bp.options import BPOptions
 from sarcover.formulations.bp.pricer import Pricer
-from sarcover.formulations.bp.search import TOL, Search
+from sarcover.formulations.bp.root import Root
+from sarcover.formulations.bp.search import Search
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
 
@@ -47,7 +48,7 @@ class BranchAndPrice:
         s = self.search = Search(instance, time_limit, opts)
 
         def share(f: float) -> float:  # seconds for a root dive, the labelling arc bounds
-            return f * s.limit if math.isfinite(s.limit) else 30.0
+            return f * s.clock.limit if math.isfinite(s.clock.limit) else 30.0
 
         self.pricer = Pricer(s, opts.bidirectional, opts.ng_columns, opts.exact_keep,
                              opts.exact_labels)
@@ -55,24 +56,25 @@ class BranchAndPrice:
                                        pool_routes=opts.pool_routes)
         self.incumbents = IncumbentSearch(
             s, self.pricer, self.elimination, primal, dive_limit=share(opts.dive_share),
-            primal_limit=min(opts.primal_share * s.limit, opts.primal_cap_s))
+            primal_limit=min(opts.primal_share * s.clock.limit, opts.primal_cap_s))
         self.cuts = CutRounds(s, self.elimination, rounds=opts.cut_rounds,
                               per_round=opts.cuts_per_round, gap=opts.cut_gap,
-                              until=s.until(opts.cut_share))
+                              until=s.clock.until(opts.cut_share))
         self.enumeration = (Enumeration(s, self.elimination, self.incumbents,
                                         limit=share(opts.enum_share), gap=opts.enum_gap,
                                         max_labels=opts.enum_labels, max_routes=opts.enum_routes,
                                         primal_window=opts.enum_primal_window)
                             if opts.enum_share > 0 else None)
-        self.colgen = ColumnGeneration(s, self.pricer, self.elimination, self.incumbents,
-                                       self.cuts, ng_cap=opts.ng_cap,
-                                       grow_until=s.until(opts.grow_share))
+        self.colgen = ColumnGeneration(s, self.pricer, self.elimination, ng_cap=opts.ng_cap,
+                                       grow_until=s.clock.until(opts.grow_share))
+        self.root = Root(s, self.colgen, self.elimination, self.incumbents, self.cuts)
+        self.colgen.root = self.root
         # starting columns: every reachable point alone, and the warm start's routes
         routes = warm_start.routes if warm_start is not None else ()
-        cols = [(int(p),) for p in np.flatnonzero(s.reachable)]
+        cols = [(int(p),) for p in np.flatnonzero(s.problem.reachable)]
         for r in routes:
             pts = tuple(int(v) + 1 for v in r)
-            if pts and s.energy(pts) <= s.budget:
+            if pts and s.problem.energy(pts) <= s.problem.budget:
                 cols.append(pts)
         s.master.add_routes(cols)
         if routes:
@@ -82,51 +84,20 @@ class BranchAndPrice:
         """Heap entry: best floored bound first, then deepest. Pruning only looks at floored
         bounds, so every open node of the best floor must be solved unless a plan of that value
         turns up; among them, depth first reaches integral LP solutions (plans) sooner."""
-        return (-self.search.floor(bound), -depth, -bound, counter, state)
-
-    def _solve_root(self, state: NodeState, bound: float):
-        """The root's column generation, then, once its LP is solved: tighter arc bounds by
-        labelling (and the root again on the smaller graph if they remove arcs: its bound may
-        now prove the plan) and a dive from the final root LP (the first dive ran before the ng
-        sets grew), then the caller's heuristic once more if the proof is still open. Returns
-        what :meth:`.colgen.ColumnGeneration.solve` does."""
-        s, m, elim = self.search, self.search.master, self.elimination
-        bound, x, xa, converged = self.colgen.solve(state, bound)
-        if converged and not s.prunable(bound):
-            version = elim.version
-            elim.eliminate(labels=True)
-            if elim.version != version and s.time_left() > 0:
-                bound, x, xa, converged = self.colgen.solve(state, bound)
-            elif len(x) != m.n_routes:
-                # the route pool joined after the LP was solved (and no time is left to
-                # re-solve the root): the LP solution over all of the master's columns
-                m.apply(state)
-                _, x, xa, _ = m.solve()
-        s.stats.root_bound = bound if math.isfinite(bound) else None
-        s.stats.root_s = time.perf_counter() - s.t0
-        if converged and not s.prunable(bound) and s.time_left() > 0:
-            inc = self.incumbents
-            inc.dived = True
-            inc.dive(min(inc.dive_limit, 0.5 * s.time_left()))
-            # the heuristic again, now that the cut rounds are done: each call is another draw
-            while not s.prunable(bound) and inc.call_primal():
-                pass
-            m.apply(state)  # back to the root, with the dive's (and heuristic's) columns
-            _, x, xa, _ = m.solve()
-        return bound, x, xa, converged
+        return (-self.search.problem.floor(bound), -depth, -bound, counter, state)
 
     def run(self):
         """Explore the tree until it is closed or the time is up. Returns (proven, bound)."""
         s, m, inc, opts = self.search, self.search.master, self.incumbents, self.options
         root = NodeState()
-        trivial = float(s.inst.prizes[s.reachable[1 : s.V + 1]].sum())
+        trivial = float(s.problem.inst.prizes[s.problem.reachable[1 : s.problem.V + 1]].sum())
         heap = [self._node_key(trivial, 0, 0, root)]
         counter = 1
         unresolved = []  # nodes we cannot split further (should not happen) with their bounds
         last_milp_cols = 0
         proven = False
         while heap:
-            if s.time_left() <= 0:
+            if s.clock.time_left() <= 0:
                 break
             if s.stats.nodes and self.enumeration is not None and self.enumeration.close():
                 return self._close([], [], True)  # every better plan was among its routes
@@ -136,13 +107,13 @@ class BranchAndPrice:
                 continue
             s.stats.nodes += 1
             if state.depth == 0:
-                bound, x, xa, converged = self._solve_root(state, parent_bound)
-                if s.time_left() > 0:
-                    inc.run_milp(min(10.0, 0.25 * s.time_left()))
+                bound, x, xa, converged = self.root.solve(state, parent_bound)
+                if s.clock.time_left() > 0:
+                    inc.run_milp(min(10.0, 0.25 * s.clock.time_left()))
                     last_milp_cols = m.n_routes
             else:
                 bound, x, xa, converged = self.colgen.solve(state, parent_bound)
-            if not converged and s.time_left() <= 0:
+            if not converged and s.clock.time_left() <= 0:
                 heapq.heappush(heap, self._node_key(bound, state.depth, counter, state))
                 counter += 1
                 break
@@ -151,9 +122,9 @@ class BranchAndPrice:
             # branched on its current LP: the children's pricing graphs are smaller
             if s.prunable(bound):
                 continue
-            if s.stats.nodes % opts.dive_every == 0 and s.time_left() > 0:
+            if s.stats.nodes % opts.dive_every == 0 and s.clock.time_left() > 0:
                 # dive again from this node (other fixings than the root's dive)
-                inc.dive(min(0.3 * inc.dive_limit, 0.25 * s.time_left()), start=state)
+                inc.dive(min(0.3 * inc.dive_limit, 0.25 * s.clock.time_left()), start=state)
                 m.apply(state)
                 _, x, xa, _ = m.solve()
                 if s.prunable(bound):
@@ -170,13 +141,13 @@ class BranchAndPrice:
                 heapq.heappush(heap, self._node_key(bound, ch.depth, counter, ch))
                 counter += 1
             if s.stats.nodes % opts.milp_every == 0 and m.n_routes > last_milp_cols:
-                inc.run_milp(min(5.0, 0.1 * max(s.time_left(), 0.0)))
+                inc.run_milp(min(5.0, 0.1 * max(s.clock.time_left(), 0.0)))
                 last_milp_cols = m.n_routes
         else:
             proven = not unresolved
         if not proven and m.n_routes:
             # the time kept in reserve: a last MILP over everything generated
-            inc.run_milp(max(0.0, s.hard_deadline - time.perf_counter() - 0.1))
+            inc.run_milp(max(0.0, s.clock.hard_deadline - time.perf_counter() - 0.1))
         return self._close([-item[2] for item in heap], unresolved, proven)
 
     def _close(self, open_bounds: list, unresolved: list, finished: bool):
@@ -190,6 +161,6 @@ class BranchAndPrice:
         inc = s.incumbent_value if s.incumbent is not None else -math.inf
         if not open_bounds:
             return finished, inc
-        open_bound = max(s.floor(b) for b in open_bounds)
+        open_bound = max(s.problem.floor(b) for b in open_bounds)
         proven = s.incumbent is not None and not unresolved and open_bound <= inc + TOL
         return proven, max(inc, open_bound)

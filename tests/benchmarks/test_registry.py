@@ -167,7 +167,7 @@ def test_ad_hoc_methods_do_not_join_the_registry(tmp_path):
 WARM_CHECK = r"""
 import json, sys
 from numba.core.registry import CPUDispatcher
-import sarcover.formulations.bp.pricing as pricing
+from sarcover.formulations.bp.compile import KERNEL_MODULES
 import sarcover.heuristics.kernels as kernels
 from sarcover.benchmarks.registry import METHODS, run_method, warm_up
 from sarcover.formulations.generate import generate
@@ -175,7 +175,7 @@ from sarcover.formulations.instance import to_top
 
 def compiled():
     out = {}
-    for mod in (pricing, kernels):
+    for mod in (*KERNEL_MODULES, kernels):
         for name in dir(mod):
             f = getattr(mod, name)
             if isinstance(f, CPUDispatcher):
@@ -202,7 +202,7 @@ def test_warm_up_leaves_nothing_for_the_jobs_to_compile():
     data = json.loads(out.stdout.strip().splitlines()[-1])
     assert sorted(data["hooks"]) == sorted({m.warm_up.__name__ for m in METHODS.values() if m.warm_up})
     assert sum(data["before"].values()) == 0  # a fresh process: nothing compiled yet
-    assert data["warmed"]["sarcover.formulations.bp.pricing._label"] > 0
+    assert data["warmed"]["sarcover.formulations.bp.labelling.label_search"] > 0
     assert data["warmed"]["sarcover.heuristics.kernels.pso_iterations"] > 0
     assert data["after"] == data["warmed"]
     assert set(data["statuses"].values()) <= {"optimal", "feasible"}

@@ -1,10 +1,14 @@
-"""A branch-and-bound node: its branching decisions, and the pricing graph they leave.
+"""The pricing graph: a branch-and-bound node's decisions (:class:`NodeState`), the graph they
+leave (:func:`node_graph`), the cheapest energy to the end, and the reversed graph that backward
+searches run on. What the labelling remembers on it: :mod:`.ng_sets`.
 
 Every kind of decision keeps the pricing a plain labelling on a modified graph: a forbidden node
 leaves the graph, a forced node only changes its master row (``= 1``); a bound on a group's
 visits only changes the group's row (its dual joins the prizes of the group's points, as the
 cover row's does); a forbidden arc is removed, a forced arc (a, b) removes every other arc out of
 a and into b.
+
+Solver points: 0 is the start, node id v is point v + 1, n - 1 is the end.
 """
 
 from __future__ import annotations
@@ -13,8 +17,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-
-from sarcover.formulations.bp.pricing import cheapest_return
 
 if TYPE_CHECKING:
     from sarcover.formulations.bp.search import Search
@@ -42,8 +44,8 @@ def node_graph(search: "Search", state: NodeState):
     """The pricing graph at a node: (arc costs with the removed arcs at inf, cheapest energy to
     the end from each point, allowed points). Eliminated arcs (:mod:`.elimination`) are removed
     too, and a point whose every incoming arc is gone is no longer allowed."""
-    cost = search.cost.copy()
-    n = search.V + 2
+    cost = search.problem.cost.copy()
+    n = search.problem.V + 2
     end = n - 1
     for a, b in state.forbidden_arcs:
         cost[a, b] = np.inf
@@ -56,7 +58,7 @@ def node_graph(search: "Search", state: NodeState):
             keep = cost[a, b]
             cost[:, b] = np.inf
             cost[a, b] = keep
-    allowed = search.reachable.copy()
+    allowed = search.problem.reachable.copy()
     for p in state.forbidden_nodes:
         allowed[p] = False
     eliminated = search.master.eliminated
@@ -66,3 +68,26 @@ def node_graph(search: "Search", state: NodeState):
         np.fill_diagonal(into, False)
         allowed &= into.any(axis=0)
     return cost, cheapest_return(cost), allowed
+
+
+def cheapest_return(cost: np.ndarray) -> np.ndarray:
+    """Cheapest energy from each point to the end (index n-1) over allowed arcs (Bellman-Ford)."""
+    n = cost.shape[0]
+    ret = cost[:, n - 1].copy()
+    ret[n - 1] = 0.0
+    for _ in range(n):
+        new = np.minimum(ret, (cost[:, 1 : n - 1] + ret[None, 1 : n - 1]).min(axis=1))
+        new[n - 1] = 0.0
+        if np.array_equal(new, ret):
+            break
+        ret = new
+    return ret
+
+
+def reversed_graph(cost, profit, allowed):
+    """The reversed graph (start and end swapped, arcs turned): permutation, cost, profit,
+    allowed. Points 1..n-2 keep their numbers."""
+    end = cost.shape[0] - 1
+    perm = np.concatenate([[end], np.arange(1, end), [0]])
+    return (perm, np.ascontiguousarray(cost.T[np.ix_(perm, perm)]),
+            np.ascontiguousarray(profit[perm]), allowed[perm])

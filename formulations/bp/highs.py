@@ -1,0 +1,47 @@
+"""The HiGHS helpers the branch-and-price's LPs and MILPs share: a silent single-thread solver,
+and the set-packing MILP over routes."""
+
+from __future__ import annotations
+
+import highspy
+import numpy as np
+from pyomo.common.tee import capture_output
+
+INF = highspy.kHighsInf
+
+
+def quiet_highs() -> highspy.Highs:
+    """A silent single-thread HiGHS. Its constructor prints a banner on file descriptor 1 (C++
+    output: `sarcover solve --json` must print one JSON object only), so it is built with fd 1
+    captured, as Pyomo's own HiGHS interface does."""
+    with capture_output(capture_fd=True):
+        h = highspy.Highs()
+    h.setOptionValue("output_flag", False)
+    h.setOptionValue("threads", 1)
+    return h
+
+
+def packing_milp(lo, hi, prize, ub, starts, index, value, time_limit: float, *,
+                 first: np.ndarray | None = None, abs_gap: bool = False) -> highspy.Highs:
+    """HiGHS run on a set-packing MILP over routes: binary columns (``prize``, upper bounds
+    ``ub``, CSC arrays ``starts``, ``index``, ``value`` with ``starts`` holding the columns'
+    first entries), rows between ``lo`` and ``hi``, maximised to a zero relative gap (and zero
+    absolute gap with ``abs_gap``) within ``time_limit`` seconds; ``first``: a 0/1 first
+    solution. The caller reads the outcome from the returned solver."""
+    k = len(prize)
+    h = quiet_highs()
+    h.setOptionValue("time_limit", max(0.05, float(time_limit)))
+    h.setOptionValue("mip_rel_gap", 0.0)
+    if abs_gap:
+        h.setOptionValue("mip_abs_gap", 0.0)
+    h.changeObjectiveSense(highspy.ObjSense.kMaximize)
+    h.addRows(len(lo), lo, hi, 0, np.zeros(len(lo), np.int32), np.zeros(0, np.int32), np.zeros(0))
+    h.addCols(k, prize, np.zeros(k), ub, len(index), starts, index, value)
+    h.changeColsIntegrality(k, np.arange(k, dtype=np.int32), np.full(k, highspy.HighsVarType.kInteger))
+    if first is not None:
+        sol = highspy.HighsSolution()
+        sol.col_value = np.asarray(first, dtype=float).tolist()
+        sol.value_valid = True
+        h.setSolution(sol)
+    h.run()
+    return h

@@ -1,0 +1,45 @@
+"""Column generation below the root: targeted pricing keeps the floor; a label cap leads to branching."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sarcover.formulations.bp import BPOptions, solve_bp
+from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.io import load_instance
+from sarcover.formulations.result import Status
+from sarcover.formulations.verify import verify
+
+from bp_cases import OPTIMAL, TOP_DIR, plan_prize
+
+
+@pytest.mark.parametrize("value,n", [(57.3, 5), (57.0, 5), (12.999, 3), (4.2, 1)])
+def test_targeted_slack_keeps_the_floor(value, n):
+    """The raised exact-pricing threshold: dual value + N * (slack + TOL) stays below the next
+    integer (or incumbent + 1), so 'nothing found above the threshold' settles floor(bound)."""
+    from sarcover.formulations.bp.constants import TOL
+    from sarcover.formulations.bp.tree import BranchAndPrice
+
+    inst = TOPInstance(coords=[[1, 0]], prizes=[1], start=[0, 0], end=[0, 0], budget=5.0, n_vehicles=n)
+    bp = BranchAndPrice(inst, time_limit=10)
+    for inc in (None, int(value) - 2, int(value) + 1):
+        bp.search.incumbent, bp.search.incumbent_value = (None, -np.inf) if inc is None else ([], float(inc))
+        slack = bp.colgen.slack(value)
+        target = max(np.floor(value + 1e-6) + 1, (inc if inc is not None else -np.inf) + 1)
+        assert slack >= 0
+        if slack > 0:
+            assert np.floor(value + n * (slack + TOL) + 1e-6) < target
+
+
+def test_label_cap_without_cuts_branches_instead_of_stopping():
+    """With no cuts to withdraw, a node whose exact pricing hits the label cap is branched on
+    its unconverged LP (its bound still holds) until the time is up: the run neither stops at
+    the root nor claims more than it proved, and its plan is valid."""
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    r = solve_bp(inst, time_limit=4, options=BPOptions(cut_rounds=0, exact_labels=1))
+    assert r.info["label_caps"] > 1 and r.info["nodes"] > 1
+    assert verify(inst, r.plan).valid and plan_prize(inst, r) <= OPTIMAL["p2.2.k"]
+    assert r.bound >= OPTIMAL["p2.2.k"] - 1e-6
+    if r.status == Status.OPTIMAL:
+        assert plan_prize(inst, r) == pytest.approx(OPTIMAL["p2.2.k"])
