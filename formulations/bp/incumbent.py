@@ -100,7 +100,7 @@ class IncumbentSearch:
         allowance = min(self.primal_limit, 0.5 * s.clock.time_left())
         try:
             routes = self.primal(allowance)
-        except Exception as exc:  # a failing heuristic must not cost the proof search
+        except Exception as exc:  # noqa: BLE001 - a failing heuristic must not cost the proof search
             s.stats.primal_error = f"{type(exc).__name__}: {exc}"
             routes = None
         s.stats.primal_s = round((s.stats.primal_s or 0.0) + time.perf_counter() - t, 3)
