@@ -7,7 +7,8 @@ the incumbent. The root gets more than the other nodes (its policy: :mod:`.root`
 over the generated routes once it is solved; later nodes get a dive every ``dive_every`` nodes
 and a MILP every ``milp_every`` nodes, and before each, route enumeration under the root's
 certificate (:mod:`.enumeration`) is tried when the certificate or the incumbent has changed.
-The reported bound is max(incumbent, floored bounds of the open nodes), certified at every stop; a run whose open nodes all floor to the incumbent is proven.
+The reported bound is max(incumbent, floored bounds of the open nodes), certified at every stop;
+a run whose open nodes all floor to the incumbent is proven.
 """
 
 from __future__ import annotations
