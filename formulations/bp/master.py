@@ -37,8 +37,8 @@ sum_r x_r <= N and L <= A x <= U. Only plans of elementary routes need to satisf
 the integer solutions), so the bound stays valid whichever repeated routes the LP holds, and rc*
 may come from ng-route pricing, which covers every elementary route. When y is the optimal dual
 of the restricted LP the second term is its value (with the artificials' prize included, which
-only lowers it), so this is the usual ``z_RMP + N·rc*`` (Farley/Lagrangian) bound. It does not need the LP to be converged or even
-feasible without artificials; duals are clipped to their sign so that the formula holds exactly.
+only lowers it), so this is the usual ``z_RMP + N·rc*`` (Farley/Lagrangian) bound. It does not
+need the LP to be converged or even feasible without artificials; duals are clipped to their sign so that the formula holds exactly.
 """
 
 from __future__ import annotations
