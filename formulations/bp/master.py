@@ -38,7 +38,8 @@ the integer solutions), so the bound stays valid whichever repeated routes the L
 may come from ng-route pricing, which covers every elementary route. When y is the optimal dual
 of the restricted LP the second term is its value (with the artificials' prize included, which
 only lowers it), so this is the usual ``z_RMP + N·rc*`` (Farley/Lagrangian) bound. It does not
-need the LP to be converged or even feasible without artificials; duals are clipped to their sign so that the formula holds exactly.
+need the LP to be converged or even feasible without artificials; duals are clipped to their
+sign so that the formula holds exactly.
 """
 
 from __future__ import annotations
