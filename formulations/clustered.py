@@ -8,7 +8,7 @@ of their UAVs. OPT|C is the optimum of that restriction: what a perfect router c
 clustering. Every restricted plan is a plan, so OPT|C <= OPT, and OPT − OPT|C is the loss of the
 clustering stage.
 
-Two exact methods; they agree with each other and with brute force (tests/test_clustered.py).
+Two exact methods; they agree with each other and with brute force (tests/formulations/test_clustered.py).
 
 :func:`solve_clustered` (the one to use) decomposes by cluster. Cluster i alone is a
 single-vehicle orienteering problem; the clusters interact only through the groups split across

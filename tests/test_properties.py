@@ -90,6 +90,7 @@ def one_line(exc: Exception) -> None:
 @example({**VALID, "targets": [[1e300, 1e300]]})
 @example({**VALID, "e_maxx": 1})
 def test_any_json_value_is_an_instance_or_one_instance_error(value):
+    """Any JSON value is read as an instance or refused with one InstanceError line, nothing else."""
     with strict():
         try:
             sar = sar_from_dict(value, source="x.json")
@@ -133,6 +134,7 @@ def top_texts(draw):
 @FAST
 @given(top_texts())
 def test_any_top_file_text_is_an_instance_or_one_instance_error(text):
+    """Any TOP-file text is read as an instance or refused with one InstanceError line, nothing else."""
     path = WORK / "any.txt"
     path.write_bytes(text.encode("utf-8", "surrogatepass"))  # a lone surrogate makes it not UTF-8
     with strict():
@@ -217,6 +219,7 @@ def argument_lists(draw):
 @example(["methods", "\x1e"])  # a line break of str.splitlines in an argument
 @example(["generate", "-M", "3", "-K", "2", "-N", "1", "-o", "\x00"])
 def test_any_argument_list_gives_a_documented_exit_code_and_at_most_one_stderr_line(argv):
+    """Any argument list exits with a documented code and at most one stderr line, never a traceback."""
     out, err = io.StringIO(), io.StringIO()
     cwd = os.getcwd()
     os.chdir(WORK)  # relative -o names land in the scratch folder

@@ -19,7 +19,7 @@ from sarcover.formulations.result import Status
 from sarcover.formulations.verify import verify
 from sarcover.heuristics.pipeline import cluster_stage, route_clusters
 
-from test_clustered import brute_clustered
+from brute_force import brute_clustered
 
 
 @pytest.fixture(scope="module")

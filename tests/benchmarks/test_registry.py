@@ -148,7 +148,6 @@ def test_run_method_prechecks_once_and_the_solver_is_not_called(monkeypatch):
     assert res.status == Status.INFEASIBLE and "cannot be covered" in res.reason and calls == []
 
 
-# -- moved from tests/test_bench_harness.py ---------------------------------------------------------
 def test_ad_hoc_methods_do_not_join_the_registry(tmp_path):
     """A suite's ``module:function`` method runs, but never shows up in the shared registry."""
     from sarcover.benchmarks.registry import METHODS, get_method, run_method

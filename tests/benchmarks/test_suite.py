@@ -116,7 +116,6 @@ def test_bad_parameters_in_a_suite_are_one_line_before_anything_runs(tmp_path, c
     assert not (tmp_path / "res").exists()
 
 
-# -- moved from tests/test_bench_harness.py ---------------------------------------------------------
 @pytest.mark.parametrize("body, needle", [
     ('methods = ["greedy", "no-such-method"]\n[[instances]]\nM = 3\nK = 2\nN = 1', "unknown method 'no-such-method'"),
     ('methods = ["greedy"]\n[[instances]]\nM = 3\nK = 0\nN = 1', "K must be >= 1"),

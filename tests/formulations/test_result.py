@@ -44,6 +44,7 @@ def test_a_time_limited_run_with_a_plan_differs_from_one_without():
 
 
 def test_verified_result_takes_the_verifiers_objective_and_leaves_the_result_alone(inst):
+    """The verified result counts the verifier's objective and leaves the method's Result untouched."""
     res = Result("m", Termination.OPTIMAL, plan=Plan.of([[0, 1]]), bound=3.0, runtime_s=0.5)
     run = verified_result(inst, res, method="name")
     assert run.objective == 3.0 and run.status is Status.OPTIMAL and run.method == "name"

@@ -2,7 +2,6 @@
 
 import csv
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +14,8 @@ from sarcover.formulations.result import Status
 from sarcover.formulations.verify import verify
 from sarcover.heuristics.greedy import greedy
 
-TOP_DIR = Path(__file__).resolve().parents[1] / "benchmarks" / "instances" / "top"
+from conftest import TOP_DIR
+
 
 PUBLISHED = {r["instance"]: float(r["value"]) for r in csv.DictReader(open(TOP_DIR / "optimal.csv"))}
 

@@ -2,7 +2,6 @@
 budgets, verified plans on random instances, and never beating published TOP optima."""
 
 import csv
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,7 +12,8 @@ from sarcover.formulations.instance import TOPInstance, to_top
 from sarcover.formulations.io import load_instance
 from sarcover.formulations.result import Status
 
-TOP_DIR = Path(__file__).resolve().parents[1] / "benchmarks" / "instances" / "top"
+from conftest import TOP_DIR
+
 PEERS = ["routing", "pyvrp"]
 FAST = 1.0  # seconds per run in the default tests
 

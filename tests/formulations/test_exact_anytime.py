@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import csv
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,7 +18,8 @@ from sarcover.formulations.result import Status
 from sarcover.reports.report import write_report
 from sarcover.reports.results import SCHEMA_VERSION
 
-TOP_DIR = Path(__file__).resolve().parents[1] / "benchmarks" / "instances" / "top"
+from conftest import TOP_DIR
+
 PUBLISHED = {r["instance"]: (float(r["value"]), r["status"]) for r in csv.DictReader(open(TOP_DIR / "optimal.csv"))}
 EPS = 1e-6
 

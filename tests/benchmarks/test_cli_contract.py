@@ -16,7 +16,7 @@ from sarcover.formulations.io import sar_to_dict, save_json
 from sarcover.formulations.limits import MAX_NODES, MAX_VEHICLES
 from sarcover.benchmarks.registry import METHODS
 
-TESTS = Path(__file__).resolve().parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def cli(*args, cwd=None, memory_mb=None, stdout=subprocess.PIPE):
@@ -168,7 +168,7 @@ def test_exit_codes_are_documented_in_help_and_readme(capsys):
     assert "default method is greedy" in text and "JSON" in text and "TOP" in text and "p2.3.g" in text
     for code in (EXIT_OK, EXIT_BAD_INPUT, EXIT_NO_PLAN, EXIT_METHOD_ERROR):
         assert f" {code} " in text
-    readme = (TESTS.parent / "README.md").read_text()
+    readme = (ROOT / "README.md").read_text()
     section = readme[readme.index("### Exit codes"):]
     section = section[:section.index("\n## ")]
     for code, word in ((EXIT_OK, "plan"), (EXIT_BAD_INPUT, "bad input"), (EXIT_NO_PLAN, "no plan"),
@@ -178,6 +178,7 @@ def test_exit_codes_are_documented_in_help_and_readme(capsys):
 
 # -- conveniences ---------------------------------------------------------------------------------
 def test_version(capsys):
+    """`--version` prints the installed version and exits 0."""
     assert main(["--version"]) == EXIT_OK
     assert capsys.readouterr().out.strip() == f"sarcover {sarcover.__version__}"
 
@@ -192,6 +193,7 @@ def test_solve_takes_a_benchmark_name_and_says_where_it_plotted(tmp_path, capsys
 
 
 def test_one_uav_is_singular(tmp_path, capsys):
+    """Counts of one are written in the singular (1 target, 1 view, 1 UAV, 1 viewpoint)."""
     assert main(["generate", "-M", "1", "-K", "1", "-N", "1", "-o", str(tmp_path / "a.json")]) == EXIT_OK
     assert "1 target × 1 view, 1 UAV, E_max" in capsys.readouterr().out
     assert main(["solve", str(tmp_path / "a.json")]) == EXIT_OK

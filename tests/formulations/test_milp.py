@@ -5,7 +5,6 @@ from __future__ import annotations
 import csv
 import itertools
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,7 +18,8 @@ from sarcover.formulations.result import Status
 from sarcover.formulations.preprocess import floor_to_lattice, incompatible_cliques, prize_lattice, prune_arcs
 from sarcover.formulations.verify import route_energy
 
-TOP_DIR = Path(__file__).resolve().parents[1] / "benchmarks" / "instances" / "top"
+from conftest import TOP_DIR
+
 PUBLISHED = {r["instance"]: float(r["value"]) for r in csv.DictReader(open(TOP_DIR / "optimal.csv"))}
 
 
