@@ -115,7 +115,7 @@ METHODS: dict[str, Method] = {spec.name: spec for spec in [
            "CP-SAT routes constraint + energy flow, greedy hint, 1 thread; optimal only if proven unscaled",
            max_nodes=CPSAT_MAX_NODES),
     Method("routing", m.routing, False,
-           "OR-Tools routing, prize disjunctions + energy dimension, guided local search, <=10 s",
+           "OR-Tools routing, prize disjunctions + energy dimension, guided local search",
            max_nodes=ROUTING_MAX_NODES),
     Method("pyvrp", m.pyvrp, False,
            "PyVRP iterated local search, optional clients with prizes, max distance = energy, 2000 its",
