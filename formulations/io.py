@@ -98,7 +98,7 @@ def sar_from_dict(data, source: str = "instance") -> SARInstance:
 
 def load_sar(path: str | Path) -> SARInstance:
     path = Path(path)
-    text = _read_text(path)
+    text = read_text_file(path)
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
@@ -113,7 +113,7 @@ def load_sar(path: str | Path) -> SARInstance:
 def read_top(path: str | Path) -> TOPInstance:
     """Read a Chao–Golden–Wasil TOP file: E_F = 1, E_I = 0, budget tmax, Euclidean distances."""
     path = Path(path)
-    lines = [ln.split() for ln in _read_text(path).splitlines() if ln.strip()]
+    lines = [ln.split() for ln in read_text_file(path).splitlines() if ln.strip()]
     header: dict[str, float] = {}
     for key, row in zip(("n", "m", "tmax"), lines[:3]):
         if len(row) != 2 or row[0] != key:
@@ -161,7 +161,7 @@ def read_top(path: str | Path) -> TOPInstance:
 def load_instance(path: str | Path) -> TOPInstance:
     """Load a JSON SAR instance or a TOP benchmark file into the TOP form."""
     path = Path(path)
-    text = _read_text(path).lstrip()
+    text = read_text_file(path).lstrip()
     if text.startswith("{") or path.suffix.lower() == ".json":
         return to_top(load_sar(path))
     if text.startswith("n"):
@@ -169,16 +169,18 @@ def load_instance(path: str | Path) -> TOPInstance:
     raise InstanceError(f"{path}: neither a sarcover JSON instance nor a TOP benchmark file")
 
 
-def _read_text(path: Path) -> str:
+def read_text_file(path: Path, error: type[Exception] = InstanceError, kind: str = "an instance file") -> str:
+    """The text of ``path``, or ``error`` with one line naming why it cannot be read (``kind``
+    names what the file should have been)."""
     try:
         return path.read_text()
     except FileNotFoundError:
-        raise InstanceError(f"{path}: no such file") from None
+        raise error(f"{path}: no such file") from None
     except IsADirectoryError:
-        raise InstanceError(f"{path}: is a directory, not an instance file") from None
+        raise error(f"{path}: is a directory, not {kind}") from None
     except UnicodeDecodeError:
-        raise InstanceError(f"{path}: not a text file") from None
+        raise error(f"{path}: not a text file") from None
     except OSError as exc:
-        raise InstanceError(f"{path}: cannot read ({exc.strerror})") from None
+        raise error(f"{path}: cannot read ({exc.strerror})") from None
     except ValueError:  # a name the operating system cannot take (a NUL byte)
-        raise InstanceError(f"{str(path)!r}: not a usable file name") from None
+        raise error(f"{str(path)!r}: not a usable file name") from None

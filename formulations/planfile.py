@@ -32,6 +32,7 @@ from pathlib import Path
 
 from sarcover.formulations.errors import SarcoverError
 from sarcover.formulations.instance import TOPInstance
+from sarcover.formulations.io import read_text_file
 from sarcover.formulations.limits import shown
 from sarcover.formulations.plan import Plan
 
@@ -125,18 +126,7 @@ def plan_from_dict(data, instance: TOPInstance | None = None, source: str = "pla
 def load_plan(path: str | Path, instance: TOPInstance | None = None) -> PlanFile:
     """Read and validate the plan file at ``path`` (against ``instance`` if given)."""
     path = Path(path)
-    try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise PlanFileError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise PlanFileError(f"{path}: is a directory, not a plan file") from None
-    except UnicodeDecodeError:
-        raise PlanFileError(f"{path}: not a text file") from None
-    except OSError as exc:
-        raise PlanFileError(f"{path}: cannot read ({exc.strerror})") from None
-    except ValueError:  # a name the operating system cannot take (a NUL byte)
-        raise PlanFileError(f"{str(path)!r}: not a usable file name") from None
+    text = read_text_file(path, PlanFileError, "a plan file")
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
