@@ -270,18 +270,21 @@ def best_at(tab: pd.DataFrame, setting: str, at: float, clock: str = "wall") -> 
 
 
 def write_convergence(rows: pd.DataFrame, optimum_rows: list[pd.DataFrame], out: str | Path, *,
-                      heading: str = "##", prefix: str = "anytime") -> str:
+                      heading: str = "##", prefix: str = "anytime", pool: str | None = None) -> str:
     """Write the section's figures (``{prefix}_<setting>.png``) and CSVs (``{prefix}_table.csv``,
     ``{prefix}_curves.csv``, ``{prefix}_runs.csv``) into ``out``; return its Markdown.
 
     ``rows``: the runs (with ``info.history``); ``optimum_rows``: frames whose ``optimal`` rows
-    give the proven optima (``rows`` itself is added)."""
+    give the proven optima (``rows`` itself is added); ``pool``: one setting of this name for all
+    instances (one figure and table) instead of one per setting."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     optima = proven_optima(rows, *optimum_rows)
     insts = rows.drop_duplicates("instance").set_index("instance")
     left_out = sorted(set(insts.index) - set(optima.index))
     runs = runs_table(rows, optima)
+    if pool is not None and not runs.empty:
+        runs = runs.assign(setting=pool)
     L = [f"{heading} Gap over time for every method", ""]
     if runs.empty:
         return "\n".join(L + ["No run on an instance with a proven optimum.", ""])
@@ -294,7 +297,14 @@ def write_convergence(rows: pd.DataFrame, optimum_rows: list[pd.DataFrame], out:
 
     runs.assign(**{c: runs[c].map(joined) for c in ("times", "gaps", "times_cpu", "gaps_cpu")}).to_csv(
         out / f"{prefix}_runs.csv", index=False)
-    L += [f"Every method with the same time limit ({limit:g} s, one thread) on the same instances; the mean gap "
+    limits = runs.groupby("method")["limit"].agg(["min", "max"])
+    if limits["max"].nunique() == 1 and (limits["min"] == limits["max"]).all():
+        given = f"Every method with the same time limit ({limit:g} s, one thread) on the same instances"
+    else:
+        given = ("The methods' time limits differ (" + ", ".join(
+            f"{m} {lo:g} s" if lo == hi else f"{m} {lo:g}-{hi:g} s" for m, (lo, hi) in limits.iterrows())
+            + f"; one thread each); each run is held at what it returned from its stop up to {limit:g} s")
+    L += [f"{given}; the mean gap "
           "to the proven optimum against time, where a run's gap at t is (OPT − z(t))/OPT with z(t) the best "
           "objective it had recorded by t (`info.history`; a gap of 100 % before its first plan, and after it "
           "stops the gap of what it returned). The primal integral is Berthold's: the integral of that gap over "
