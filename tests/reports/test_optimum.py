@@ -270,12 +270,14 @@ def test_decomposition_section_appears_when_its_rows_exist(tmp_path, monkeypatch
 
 
 def test_reproduce_runs_paper_opt_then_decomposition_then_top_4_7(tmp_path, monkeypatch):
-    """The steps: paper-opt, then the decomposition of its chosen settings, then top-4-7 (bp only);
+    """The steps: paper-opt, then the decomposition of its chosen settings, then top-4-7 (bp only),
+    paper-validation (bp only) and scale;
     the decomposition step takes only the settings it names, and is skipped without paper-opt."""
     from sarcover.benchmarks import decomposition, reproduce
 
     assert STEPS.index("paper-opt") + 1 == STEPS.index(DECOMPOSITION) < STEPS.index("top-4-7")
     assert EXACT_ONLY["top-4-7"] == ["bp"] and {"paper-opt", "top-4-7"} <= set(SUITES)
+    assert EXACT_ONLY["paper-validation"] == ["bp"] and {"paper-validation", "scale"} <= set(STEPS)
     assert reproduce.decompose_step(tmp_path) == 0  # no paper-opt results: nothing to do
 
     class Case:
