@@ -5,8 +5,8 @@ Per setting (M, K, N): bp's proven share and its certified gap, each method's ga
 Per instance, with ``best`` the best verified plan of any method and ``bound`` the best bound of
 any exact method (:func:`sarcover.reports.gaps.instance_table`)::
 
-    certified gap = (bound - best) / bound        0 where bp proves the optimum
-    a method's gap = (opt - obj) / opt             where the optimum is proven
+    bp's certified gap = (bp's bound - best) / bp's bound     0 where bp proves the optimum
+    a method's gap = (opt - obj) / opt             where the optimum is proven (by any exact method)
                    <= (bound - obj) / bound        where it is not: an upper bound on the true gap
 
 A setting's mean gap is marked "≤" when any of its instances is unproven (it then mixes gaps to
@@ -49,15 +49,17 @@ def _settings(df: pd.DataFrame) -> pd.DataFrame:
 
 
 def setting_table(df: pd.DataFrame) -> pd.DataFrame:
-    """Per setting, in order of viewpoints: instances, bp's runs, proofs and proven share, and the
-    certified gap (best bound − best plan)/best bound over the instances bp ran on (mean, max)."""
+    """Per setting, in order of viewpoints: instances, bp's runs, proofs and proven share, and bp's
+    certified gap (bp's bound − best plan of any method)/bp's bound over the instances bp ran on
+    (mean, max)."""
     inst = instance_table(df)
     where = _settings(df)
     bp = df[df["method"] == PROVER].drop_duplicates("instance").set_index("instance")
     inst = inst.join(where)
     inst["bp_ran"] = inst.index.isin(bp.index)
     inst["bp_proven"] = inst.index.isin(bp.index[bp["status"] == "optimal"])
-    bound, best = inst["best_bound"].astype(float), inst["best_objective"].astype(float)
+    bound = bp["bound"].astype(float).reindex(inst.index)  # bp's own certificate
+    best = inst["best_objective"].astype(float)
     with np.errstate(divide="ignore", invalid="ignore"):
         inst["certified_gap"] = np.where(bound > 0, np.maximum((bound - best) / bound, 0.0),
                                          np.where(bound.notna() & best.notna(), 0.0, np.nan))
@@ -142,18 +144,20 @@ def plot_growth(mt: pd.DataFrame, gt: pd.DataFrame, path) -> None:
     fig, (ax, ax_gap) = subplots(1, 2, figsize=(13, 4.6))
     methods = ordered(mt["method"])
     exps = gt.set_index("method")["exponent"] if len(gt) else pd.Series(dtype=float)
+    any_gap = False
     for meth in methods:
-        s = mt[mt["method"] == meth].groupby("viewpoints", as_index=False).agg(
-            runtime=("runtime_median_s", "median"), gap=("gap_any_mean", "mean"))
+        own = mt[mt["method"] == meth]  # one point per setting: the points the line is fitted to
         lk = look(meth)
-        ax.plot(s["viewpoints"], s["runtime"], ms=6, lw=0, marker=lk.marker, color=lk.color)
+        ax.plot(own["viewpoints"], own["runtime_median_s"], ms=6, lw=0, marker=lk.marker, color=lk.color)
         b = exps.get(meth, np.nan)
         if np.isfinite(b):
             a = float(gt.set_index("method").loc[meth, "coefficient_s"])
-            xs = np.array([s["viewpoints"].min(), s["viewpoints"].max()], dtype=float)
+            xs = np.array([own["viewpoints"].min(), own["viewpoints"].max()], dtype=float)
             ax.plot(xs, a * xs ** b, color=lk.color, ls=lk.ls, lw=1.3)
-        if s["gap"].notna().any():
-            ax_gap.plot(s["viewpoints"], s["gap"], ms=6, lw=1.3, **lk.line())
+        gap = own.groupby("viewpoints")["gap_any_mean"].mean().dropna()  # settings of equal size averaged
+        if len(gap):
+            any_gap = True
+            ax_gap.plot(gap.index, gap.to_numpy(), ms=6, lw=1.3, **lk.line())
     from matplotlib.ticker import NullLocator
 
     ticks = sorted(int(v) for v in mt["viewpoints"].unique())
@@ -166,6 +170,9 @@ def plot_growth(mt: pd.DataFrame, gt: pd.DataFrame, path) -> None:
     ax.set_ylabel("median runtime (s)")
     ax.set_title("Runtime against size (fitted: runtime ≈ a·(M·K)^b)", fontsize=10)
     ax.grid(alpha=0.3, which="both")
+    ax_gap.set_xlim(ax.get_xlim())
+    if not any_gap:
+        ax_gap.text(0.5, 0.5, "no gaps yet: no optimum or bound", transform=ax_gap.transAxes, ha="center")
     ax_gap.set_xlabel("viewpoints M·K")
     ax_gap.set_ylabel("mean gap (≤ where unproven)")
     ax_gap.set_title("Gap against size", fontsize=10)
@@ -213,9 +220,10 @@ def scale_section(df: pd.DataFrame | None, out, *, heading: str = "##") -> list[
              f"{', '.join(str(v) for v in sorted(df['K'].unique()))} ({int(st['viewpoints'].min())} to "
              f"{int(st['viewpoints'].max())} viewpoints), {runs.min()}"
              + (f"-{runs.max()}" if runs.max() > runs.min() else "")
-             + " instances per setting, N for mid-range coverage (docs/scale.md). bp's certified gap is "
-             "(best bound − best plan of any method)/best bound, 0 where bp proves the optimum. A method's gap "
-             "is to the proven optimum where bp proves it and to the best bound where not: there it is an upper "
+             + (" instances" if runs.max() > 1 else " instance")
+             + " per setting, N for mid-range coverage (docs/scale.md). bp's certified gap is "
+             "(bp's bound − best plan of any method)/bp's bound, 0 where bp proves the optimum. A method's gap "
+             "is to the proven optimum where one is proven and to the best bound where not: there it is an upper "
              "bound on the true gap, and a mean marked ≤ includes such upper bounds. Means with their 95 % t "
              "half-widths over the runs with a plan; runtimes are medians.", ""]
     lines += [f"{h}# bp per setting", ""]
@@ -246,7 +254,7 @@ def scale_section(df: pd.DataFrame | None, out, *, heading: str = "##") -> list[
         time_rows.append(tr)
     lines += ["", f"{h}# Gap per method and setting", "",
               "Mean gap ± 95 % t half-width; ≤: some of the setting's instances are unproven and their gaps are to "
-              "bp's bound (the CSV has the proven and the bounded parts apart).", ""]
+              "the best bound (the CSV has the proven and the bounded parts apart).", ""]
     lines += _md_table(["method"] + settings, gap_rows)
     lines += ["", f"{h}# Runtime per method and setting (median, s)", ""]
     lines += _md_table(["method"] + settings, time_rows)
