@@ -24,8 +24,15 @@ decomposition     ~12 min   clustering / cross-cluster / routing loss of the pap
                             paper-opt's optima, at N=5 K=3, N=5 K=6 and K=3 N=2..6 (one instance per
                             worker; 755 of its 960 rows took 9.3 min on 2)
 top-4-7           2.6 h     bp alone at 600 s on the 192 shipped files of TOP sets 4-7 (5.2 CPU-hours)
+paper-validation  ~1.6 h    bp alone on the paper grid with paper-opt's limits, 20 held-out instances per
+                            setting (seeds 200..219, which chose no setting): its proof rates beside
+                            paper-opt's, which are tuning figures (about paper-opt's bp part)
+scale             ~8 h      M=20..100 at K=3 and 6 (60-600 viewpoints), 10 instances each: every method
+                            against bp (60 s at K=3, 600 s at K=6; milp and cpsat only at M<=40);
+                            bp's 40 K=6 jobs at 600 s dominate (docs/scale.md)
 ================  ========  =========================================================================
 
+In all about 16 h on 2 cores, half of it scale (``--skip scale --skip paper-validation``: about 6 h).
 ``--runs R`` sets the random instances per setting of paper-n and paper-k (the paper: 1000, the
 default); ``--skip STEP`` leaves a suite or the decomposition out; ``--report-only`` only rewrites
 the report. Every step resumes: a stopped run continues where it stopped. The results directory
@@ -47,8 +54,9 @@ import time
 from pathlib import Path
 
 SUITES = ["paper-n", "paper-k", "paper-peers", "exact-small", "paper-gaps", "paper-gaps-long", "emax-sweep",
-          "table1", "top-chao", "paper-opt", "top-4-7"]
-EXACT_ONLY = {"top-chao": ["milp", "cpsat", "bp"], "top-4-7": ["bp"]}  # suites run with only these of their methods
+          "table1", "top-chao", "paper-opt", "top-4-7", "paper-validation", "scale"]
+# suites run with only these of their methods (paper-validation's greedy is there for a quick check only)
+EXACT_ONLY = {"top-chao": ["milp", "cpsat", "bp"], "top-4-7": ["bp"], "paper-validation": ["bp"]}
 DECOMPOSITION = "decomposition"  # the step after paper-opt: RESULTS/decomposition/rows.jsonl
 DECOMPOSE_FROM = "paper-opt"
 # (K, N) settings of paper-opt to decompose: Fig. 3's K=3 sweep over N and N=5 at K=6

@@ -16,6 +16,11 @@ from :func:`sarcover.reports.gaps.add_gaps`. Runs without a plan have no gap (as
 :mod:`sarcover.reports.gaps`) and count as coverage 0 in the coverage means (as in the reference
 report); the tables say how many runs had a plan.
 
+Tuning against validation: some of bp's settings were chosen on paper-opt's instances (docs/bp.md,
+"Where each setting was chosen"), so their proof rates are tuning figures. Suite
+``paper-validation`` runs bp with the same limits on fresh instances that chose nothing; the proof
+rates of both sit side by side per setting (:func:`validation_table`).
+
 Works on partial results: settings or bp rows that are not there yet are named, not guessed.
 """
 
@@ -32,6 +37,7 @@ from sarcover.reports.stats import t_halfwidth
 from sarcover.reports.style import PAPER, PEERS, dodge, legend_outside, look
 
 SUITE = "paper-opt"
+VALIDATION = "paper-validation"  # the same grid and limits on instances that chose no setting
 PROVER = "bp"  # the exact method of the suite: its proofs and bounds make the optimum
 METHODS = PAPER + PEERS + [PROVER]  # table and legend order; bp's row is its own plan
 OPT_COLOR = "0.35"  # the optimum: a wide translucent grey line/band, unlike any method's look
@@ -62,6 +68,21 @@ SWEEPS = (Sweep("paper_opt_vs_N", "N", "K", 3, (2, 3, 4, 5, 6),
 def expected_settings() -> list[tuple[int, int]]:
     """Every (K, N) setting of the two figures, once, in figure order."""
     return list(dict.fromkeys(s for sw in SWEEPS for s in sw.settings()))
+
+
+# What paper-opt's instances of each (K, N) chose among bp's settings (docs/bp.md, "Where each
+# setting was chosen"); a setting not named here chose nothing.
+TUNED_ON = {
+    (2, 5): "second primal call; enumeration from 60 s and its label cap",
+    (3, 2): "second primal call; enumeration from 60 s and its label cap",
+    (3, 3): "second primal call; enumeration from 60 s and its label cap; sub-buckets (seed 104)",
+    (3, 4): "second primal call; enumeration from 60 s and its label cap",
+    (3, 5): "second primal call; enumeration from 60 s and its label cap",
+    (3, 6): "second primal call; enumeration from 60 s and its label cap; sub-buckets (seed 117)",
+    (4, 5): "enumeration's LP stall and MILP route cap (seed 111)",
+    (5, 5): "route enumeration settings; 30 s primal calls",
+    (6, 5): "4 primal calls from 600 s; 30 s primal calls",
+}
 
 
 def proof_target(k: int) -> tuple[float, float]:
@@ -344,12 +365,92 @@ def _gap_rows(mg: pd.DataFrame, sweep: Sweep) -> tuple[list[str], list[list]]:
     return ["method"] + [f"{sweep.x}={c.split(sweep.x + '=')[1].split()[0]}" for c in have], rows
 
 
-def optimum_section(df: pd.DataFrame | None, out, *, heading: str = "##") -> list[str]:
-    """The section's Markdown lines; its PNGs and CSVs are written into ``out``."""
+# ---------------------------------------------------------------- tuning against validation
+
+
+def _seeds(df: pd.DataFrame | None) -> str:
+    """The instance seeds of ``df`` as a range ("100..119"), from the instance names."""
+    if df is None or df.empty:
+        return ""
+    seeds = df["instance"].str.extract(r"-s(\d+)", expand=False).dropna().astype(int)
+    return f"{seeds.min()}..{seeds.max()}" if len(seeds) else ""
+
+
+def _proofs(df: pd.DataFrame | None) -> pd.DataFrame:
+    """Per (K, N) with bp rows: bp's runs, proofs and the widest open bracket (bound − best plan)."""
+    cols = ["K", "N", "bp_runs", "proven", "max_bound_minus_best_plan"]
+    if df is None or df.empty or not (df["method"] == PROVER).any():
+        return pd.DataFrame(columns=cols).set_index(["K", "N"])
+    st = setting_table(brackets(df))
+    return st[st["bp_runs"] > 0][cols].set_index(["K", "N"])
+
+
+VALIDATION_COLUMNS = ["setting", "K", "N", "tuned_on", "tuning_bp_runs", "tuning_proven", "tuning_max_open",
+                      "validation_bp_runs", "validation_proven", "validation_max_open"]
+
+
+def validation_table(tuning: pd.DataFrame | None, validation: pd.DataFrame | None) -> pd.DataFrame:
+    """Per (K, N) of the figures (and any other setting either suite has): bp's proofs on the
+    tuning instances (paper-opt) and on the held-out ones (paper-validation), each with the widest
+    open bracket max(bound − best plan) over its unproven instances, and what the tuning instances
+    of the setting chose (``TUNED_ON``)."""
+    t, v = _proofs(tuning), _proofs(validation)
+    keys = list(dict.fromkeys(expected_settings() + sorted(set(t.index) | set(v.index))))
+    rows = []
+    for k, n in keys:
+        row = {"setting": label(k, n), "K": k, "N": n, "tuned_on": TUNED_ON.get((k, n), "")}
+        for name, p in (("tuning", t), ("validation", v)):
+            have = (k, n) in p.index
+            row[f"{name}_bp_runs"] = int(p.loc[(k, n), "bp_runs"]) if have else 0
+            row[f"{name}_proven"] = int(p.loc[(k, n), "proven"]) if have else 0
+            row[f"{name}_max_open"] = p.loc[(k, n), "max_bound_minus_best_plan"] if have else np.nan
+        rows.append(row)
+    return pd.DataFrame(rows, columns=VALIDATION_COLUMNS)
+
+
+def _share(proven: int, runs: int) -> str:
+    return f"{proven}/{runs} ({100 * proven / runs:.0f} %)" if runs else "–"
+
+
+def validation_lines(tuning: pd.DataFrame | None, validation: pd.DataFrame | None, out, *,
+                     heading: str = "###") -> list[str]:
+    """Markdown lines of bp's proof rates on the tuning and the validation instances side by side;
+    the table is written to ``out/paper_validation.csv``."""
+    vt = validation_table(tuning, validation)
+    vt.to_csv(out / "paper_validation.csv", index=False)
+    ran = validation is not None and (validation["method"] == PROVER).any()
+    t_seeds, v_seeds = _seeds(tuning), _seeds(validation[validation["method"] == PROVER] if ran else None)
+    lines = [f"{heading} bp's proofs on tuning and validation instances", "",
+             f"Some of bp's settings were chosen on `{SUITE}`'s instances"
+             + (f" (seeds {t_seeds})" if t_seeds else "") + ": per setting the column \"chosen on these\" "
+             "names what they chose (docs/bp.md, \"Where each setting was chosen\"), so those proof rates are "
+             f"tuning figures. Suite `{VALIDATION}` runs bp with the same limits on fresh instances"
+             + (f" (seeds {v_seeds})" if v_seeds else " (seeds 200..219)") + " that chose nothing. max bound − "
+             "plan: the widest open bracket over the unproven instances (bp's bound − best plan, viewpoints).", ""]
+    if not ran:
+        lines += [f"**Validation has not been run yet** (no bp rows of `{VALIDATION}`): the proof rates below are "
+                  f"tuning figures only. `sarcover bench {VALIDATION}` runs it (about 1.6 h on 2 cores).", ""]
+    rows = []
+    for _, r in vt.iterrows():
+        val = (_share(r["validation_proven"], r["validation_bp_runs"]) if r["validation_bp_runs"]
+               else "not run" if not ran else "no rows yet")
+        width = " / ".join(_fmt(r[c]) for c in ("tuning_max_open", "validation_max_open"))
+        rows.append([r["setting"], f"{proof_target(r['K'])[0]:g}", _share(r["tuning_proven"], r["tuning_bp_runs"]),
+                     r["tuned_on"] or "nothing", val, width])
+    lines += _md_table(["setting", "bp limit (s)", "tuning: proven", "chosen on these", "validation: proven",
+                        "max bound − plan (tuning / validation)"], rows)
+    return lines + ["", "Table: `paper_validation.csv`.", ""]
+
+
+def optimum_section(df: pd.DataFrame | None, out, *, heading: str = "##",
+                    validation: pd.DataFrame | None = None) -> list[str]:
+    """The section's Markdown lines; its PNGs and CSVs are written into ``out``. ``validation``:
+    the rows of ``paper-validation``, whose bp proofs sit beside paper-opt's (tuning) ones."""
     h = heading
     lines = [f"{h} The optimum on the paper's figures (suite `{SUITE}`)", ""]
     if df is None or df.empty:
-        return lines + [f"No rows of `{SUITE}` yet.", ""]
+        lines += [f"No rows of `{SUITE}` yet.", ""]
+        return lines + (validation_lines(df, validation, out, heading=h + "#") if validation is not None else [])
     df = df[df["kind"].fillna("sar") == "sar"] if "kind" in df else df
     br = brackets(df)
     st = setting_table(br)
@@ -358,8 +459,8 @@ def optimum_section(df: pd.DataFrame | None, out, *, heading: str = "##") -> lis
     st.to_csv(out / "paper_opt_settings.csv", index=False)
     mg.to_csv(out / "paper_opt_gaps.csv", index=False)
     lines += [f"M=20, {df.groupby(['K', 'N'])['instance'].nunique().max()} fresh random instances per setting "
-              "(instance seeds 100 on; bp's route enumeration settings were chosen on the K = 5 ones, "
-              "docs/bp.md, the others were never used to tune bp); every heuristic against the optimum. Per "
+              "(instance seeds 100 on; some of bp's settings were chosen on them, docs/bp.md and the proof "
+              "table below); every heuristic against the optimum. Per "
               "instance the optimum is bp's proven value; where bp's time limit stops the proof it lies "
               "between the best verified plan of any method and bp's certified bound. The mean optimum "
               "coverage of a setting is drawn as a line where every instance is proven and as a band [mean "
@@ -389,7 +490,8 @@ def optimum_section(df: pd.DataFrame | None, out, *, heading: str = "##") -> lis
               "optimum coverage (a bracket where some instance is unproven).", ""]
     lines += _md_table(["setting", "instances", "bp limit (s)", "proven by bp", "target", "unproven",
                         "max bound − plan (bp / best)", "mean optimum coverage", "conflicts"], _setting_rows(st))
-    lines += ["", f"{h}# Mean gap to the optimum per method", "",
+    lines += [""] + validation_lines(df, validation, out, heading=h + "#")
+    lines += [f"{h}# Mean gap to the optimum per method", "",
               "Mean (opt − objective)/opt over the runs with a plan on instances with an optimum; [lower, upper] "
               "where some optimum is only bracketed (lower: to the best known plan, upper: to bp's bound). bp's "
               "row is its own plan.", ""]

@@ -2,12 +2,13 @@
 
 ``write_reference(results_root, out_dir)`` reads the result directories that
 ``python -m sarcover.benchmarks.reproduce`` fills (one per suite: paper-n, paper-k, paper-peers, exact-small,
-paper-gaps, paper-gaps-long, emax-sweep, table1, top-chao, paper-opt, top-4-7; any may be missing, and
-``decomposition/rows.jsonl`` from the decomposition step) and writes ``out_dir/README.md`` with PNG
-figures and CSV tables beside it. Every number in the text is computed here from the stored rows.
-The sections of paper-opt (:mod:`sarcover.reports.optimum`), top-4-7
-(:mod:`sarcover.reports.top_sets`) and the decomposition (:mod:`sarcover.reports.decomposition`)
-live in their own modules and work on partial results.
+paper-gaps, paper-gaps-long, emax-sweep, table1, top-chao, paper-opt, paper-validation, scale, top-4-7; any
+may be missing, and ``decomposition/rows.jsonl`` from the decomposition step) and writes
+``out_dir/README.md`` with PNG figures and CSV tables beside it. Every number in the text is computed
+here from the stored rows. The sections of paper-opt and paper-validation
+(:mod:`sarcover.reports.optimum`), scale (:mod:`sarcover.reports.scale`), top-4-7
+(:mod:`sarcover.reports.top_sets`) and the decomposition (:mod:`sarcover.reports.decomposition`) live
+in their own modules and work on partial results.
 
 Coverage of a run = covered viewpoints / all viewpoints (M·K), as in the paper. A run without a
 plan (the method could not cover every target within E_max) counts as coverage 0 and is counted
@@ -27,6 +28,7 @@ from sarcover.reports.decomposition import write_decomposition
 from sarcover.reports.optimum import optimum_section
 from sarcover.reports.plots import save_figure, subplots
 from sarcover.reports.results import load_results
+from sarcover.reports.scale import scale_section
 from sarcover.reports.stats import holm, t_halfwidth, wilcoxon_p
 from sarcover.reports.style import PAPER, PEERS, dodge, legend_outside, look
 from sarcover.reports.top_sets import top_sets_section
@@ -131,12 +133,13 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
     t1, top = _load(root, "table1"), _load(root, "top-chao")
     opt, top47 = _load(root, "paper-opt"), _load(root, "top-4-7")
     pg_long = _load(root, "paper-gaps-long")
+    sc, val = _load(root, "scale"), _load(root, "paper-validation")
     if pg is not None and pg_long is not None:  # bp at 300 s on some of the same instances
         pg = pd.concat([pg, pg_long.assign(method=LONG_BP)], ignore_index=True)
     timing = t1 if t1 is not None else pk  # Table I from the one-worker timing suite when there
     # Only the sections the stored rows fill are written: a folder of TOP rows alone gets neither the
     # paper preset nor the paper's claims.
-    sar = any(df is not None and (df["kind"] == "sar").any() for df in (pn, pk, peers, ex, pg, em, t1, opt))
+    sar = any(df is not None and (df["kind"] == "sar").any() for df in (pn, pk, peers, ex, pg, em, t1, opt, sc, val))
     title = ("the paper reproduced, with optimality gaps" if sar or (root / DECOMPOSITION).is_file()
              else "exact solvers on the TOP benchmark")
     L: list[str] = [f"# Reference report: {title}", ""]
@@ -301,9 +304,10 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
               _projection(timing), "", "Table: `table1_runtime.csv`.", ""]
     # -- gaps
     L += _gaps_section(ex, pg, out)
-    if opt is not None:
-        L += optimum_section(opt, out)
+    if opt is not None or val is not None:  # paper-validation's proofs sit beside paper-opt's
+        L += optimum_section(opt, out, validation=val)
     L += _decomposition_section(root, out)
+    L += scale_section(sc, out)  # nothing without scale rows
     if (anytime := _load(root, "anytime")) is not None:  # gap over time; optima also from paper-opt's proofs
         L += [write_convergence(anytime, [opt] if opt is not None else [], out)]
     L += _top_section(top, out)

@@ -208,3 +208,18 @@ def test_builtin_suites_load_with_registered_methods():
     assert {j.instance for j in top47.jobs} == {n for n in shipped if n[1] in "4567"}
     refs = [(j.source["reference"], j.source["best_known"]) for j in top47.jobs]
     assert all((r is None) != (b is None) for r, b in refs)  # each file: a proven optimum or a best known value
+
+
+def test_paper_validation_is_paper_opts_grid_and_bp_limits_on_held_out_seeds():
+    """paper-validation: the settings and bp time limits of paper-opt, on instance seeds 200..219
+    (none of paper-opt's or scale's), with bp and the greedy floor only."""
+    def bp_limits(suite):
+        return {(j.source["K"], j.source["N"]): j.time_limit for j in suite.jobs if j.method == "bp"}
+
+    val, opt = load_suite("paper-validation"), load_suite("paper-opt")
+    assert bp_limits(val) == bp_limits(opt) and set(bp_limits(val).values()) == {60.0, 300.0, 600.0}
+    assert set(val.methods) == {"greedy", "bp"}
+    seeds = {j.source["instance_seed"] for j in val.jobs}
+    assert seeds == set(range(200, 220))
+    assert not seeds & {j.source["instance_seed"] for s in ("paper-opt", "scale") for j in load_suite(s).jobs}
+    assert len({j.instance for j in val.jobs}) == 9 * 20

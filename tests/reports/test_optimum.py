@@ -29,13 +29,13 @@ def row(instance, method, status, objective, bound=None, *, K=3, N=2, M=20, **ex
             "best_known": None, **extra}
 
 
-def setting_rows(K, N, opts, *, open_=(), heuristic=0.8, no_bp=()) -> list[dict]:
-    """Rows of one setting: instance i has optimum opts[i]; bp proves it unless i is in ``open_``
-    (then bp's plan is opt − 2 and its bound opt + 1, and pyvrp finds opt − 1); greedy reaches
-    ``heuristic``·opt; instances in ``no_bp`` have no bp row."""
+def setting_rows(K, N, opts, *, open_=(), heuristic=0.8, no_bp=(), seed0=100) -> list[dict]:
+    """Rows of one setting: instance i (seed ``seed0 + i``) has optimum opts[i]; bp proves it unless
+    i is in ``open_`` (then bp's plan is opt − 2 and its bound opt + 1, and pyvrp finds opt − 1);
+    greedy reaches ``heuristic``·opt; instances in ``no_bp`` have no bp row."""
     rows = []
     for i, opt in enumerate(opts):
-        name = f"sar-m20-k{K}-n{N}-s{100 + i}"
+        name = f"sar-m20-k{K}-n{N}-s{seed0 + i}"
         rows.append(row(name, "greedy", "feasible", float(np.floor(heuristic * opt)), K=K, N=N))
         if i in no_bp:
             continue
@@ -145,6 +145,43 @@ def test_partial_results_are_named_not_crashed(tmp_path):
     assert "3 of 3 instances have no bp row yet" in text and (tmp_path / "out2" / "paper_opt_vs_N.png").exists()
 
 
+def test_tuning_and_validation_side_by_side():
+    """Per setting, bp's proofs on paper-opt's (tuning) and paper-validation's instances, each with
+    the widest open bracket; settings neither suite has yet count 0 runs."""
+    tuning = pd.DataFrame(setting_rows(3, 2, [30] * 4, open_={0}) + setting_rows(5, 5, [80] * 4, open_={1, 2}))
+    held = pd.DataFrame(setting_rows(3, 2, [31] * 5, seed0=200) + setting_rows(5, 5, [82] * 5, open_={0}, seed0=200))
+    vt = optimum.validation_table(tuning, held).set_index("setting")
+    assert list(vt.index[:9]) == [optimum.label(k, n) for k, n in optimum.expected_settings()]
+    assert vt.loc["K=3 N=2", ["tuning_proven", "tuning_bp_runs", "validation_proven", "validation_bp_runs"]].tolist() \
+        == [3, 4, 5, 5]
+    assert vt.loc["K=5 N=5", ["tuning_proven", "validation_proven", "validation_bp_runs"]].tolist() == [2, 4, 5]
+    # bound opt + 1 against pyvrp's opt − 1: 2 viewpoints; nothing open: no bracket
+    assert vt.loc["K=5 N=5", "tuning_max_open"] == 2 and vt.loc["K=5 N=5", "validation_max_open"] == 2
+    assert np.isnan(vt.loc["K=3 N=2", "validation_max_open"])
+    assert vt.loc["K=4 N=5", ["tuning_bp_runs", "validation_bp_runs"]].tolist() == [0, 0]
+    assert "route enumeration" in vt.loc["K=5 N=5", "tuned_on"]
+
+
+def test_proof_table_says_when_validation_has_not_run(tmp_path):
+    """Without paper-validation rows the proof table says validation has not been run; with them
+    the reference report prints both proof rates per setting, tuning marked with what it chose."""
+    root = tmp_path / "root"
+    write_rows(root / "paper-opt", setting_rows(5, 5, [80] * 4, open_={1, 2}))
+    text = write_reference(root, tmp_path / "out", suites=SUITES).read_text()
+    assert "**Validation has not been run yet**" in text
+    line = next(x for x in text.splitlines() if x.startswith("| K=5 N=5 | 300 |"))
+    assert "| 2/4 (50 %) | route enumeration settings" in line and "| not run |" in line
+    write_rows(root / "paper-validation", [dict(r, suite="paper-validation")
+                                           for r in setting_rows(5, 5, [82] * 5, open_={0}, seed0=200)])
+    text = write_reference(root, tmp_path / "out", suites=SUITES).read_text()
+    assert "has not been run" not in text and "(seeds 200..204) that chose nothing" in text
+    line = next(x for x in text.splitlines() if x.startswith("| K=5 N=5 | 300 |"))
+    assert line.endswith("| 2/4 (50 %) | route enumeration settings; 30 s primal calls | 4/5 (80 %) | 2 / 2 |")
+    assert "| K=4 N=5 | 300 | – | enumeration's LP stall" in text and "no rows yet" in text
+    csv = pd.read_csv(tmp_path / "out" / "paper_validation.csv").set_index("setting")
+    assert csv.loc["K=5 N=5", "validation_proven"] == 4
+
+
 def top_rows() -> list[dict]:
     """bp on TOP files: a proof equal to the published optimum, a wrong proof, a bound below the
     published optimum, a plan above a best known value, a proof of a best-known-only file, and an
@@ -233,12 +270,14 @@ def test_decomposition_section_appears_when_its_rows_exist(tmp_path, monkeypatch
 
 
 def test_reproduce_runs_paper_opt_then_decomposition_then_top_4_7(tmp_path, monkeypatch):
-    """The steps: paper-opt, then the decomposition of its chosen settings, then top-4-7 (bp only);
+    """The steps: paper-opt, then the decomposition of its chosen settings, then top-4-7 (bp only),
+    paper-validation (bp only) and scale;
     the decomposition step takes only the settings it names, and is skipped without paper-opt."""
     from sarcover.benchmarks import decomposition, reproduce
 
     assert STEPS.index("paper-opt") + 1 == STEPS.index(DECOMPOSITION) < STEPS.index("top-4-7")
     assert EXACT_ONLY["top-4-7"] == ["bp"] and {"paper-opt", "top-4-7"} <= set(SUITES)
+    assert EXACT_ONLY["paper-validation"] == ["bp"] and {"paper-validation", "scale"} <= set(STEPS)
     assert reproduce.decompose_step(tmp_path) == 0  # no paper-opt results: nothing to do
 
     class Case:
