@@ -16,6 +16,8 @@ paper-gaps        6 min     M=20, N=5, K=3 and 6 (8 instances each): heuristics 
 paper-gaps-long   8 min     bp at 300 s (subset-row cuts on) on K=3 seed 5 and K=6 seeds 0..3 of paper-gaps
 emax-sweep        1.5 min   coverage against E_max = 4000..9000 at M=20, N=5, K=3 (50 instances per budget)
 table1            0.5 min   Table I timings: M=20, N=5, K=2..6, 30 instances each, on ONE worker
+anytime           ~15 min   every method at 10 s on paper-opt's K=3 and K=6 (N=5) instances: the gap over
+                            time against paper-opt's proven optima (docs/anytime.md)
 top-chao          32 min    the exact methods (milp, cpsat, bp; 60 s) on TOP sets 1-3 against published optima
 paper-opt         1.8 h     the paper's grid (Fig. 3 and 4 settings, 20 instances each): every heuristic
                             against bp's optimum (60 s at K<=3, 300 s at K=4,5, 600 s at K=6; the
@@ -54,7 +56,7 @@ import time
 from pathlib import Path
 
 SUITES = ["paper-n", "paper-k", "paper-peers", "exact-small", "paper-gaps", "paper-gaps-long", "emax-sweep",
-          "table1", "top-chao", "paper-opt", "top-4-7", "paper-validation", "scale"]
+          "table1", "anytime", "top-chao", "paper-opt", "top-4-7", "paper-validation", "scale"]
 # suites run with only these of their methods (paper-validation's greedy is there for a quick check only)
 EXACT_ONLY = {"top-chao": ["milp", "cpsat", "bp"], "top-4-7": ["bp"], "paper-validation": ["bp"]}
 DECOMPOSITION = "decomposition"  # the step after paper-opt: RESULTS/decomposition/rows.jsonl
