@@ -98,16 +98,20 @@ def sar_from_dict(data, source: str = "instance") -> SARInstance:
 
 def load_sar(path: str | Path) -> SARInstance:
     path = Path(path)
-    text = read_text_file(path)
+    return sar_from_dict(read_json_file(path), source=str(path))
+
+
+def read_json_file(path: Path, error: type[Exception] = InstanceError, kind: str = "an instance file"):
+    """The JSON value in ``path``, or ``error`` with one line naming why it cannot be read."""
+    text = read_text_file(path, error, kind)
     try:
-        data = json.loads(text)
+        return json.loads(text)
     except json.JSONDecodeError as exc:
-        raise InstanceError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+        raise error(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
     except ValueError as exc:  # e.g. an integer of more digits than Python converts
-        raise InstanceError(f"{path}: not valid JSON ({str(exc).splitlines()[0][:80]})") from None
+        raise error(f"{path}: not valid JSON ({str(exc).splitlines()[0][:80]})") from None
     except RecursionError:
-        raise InstanceError(f"{path}: not valid JSON (nested too deeply)") from None
-    return sar_from_dict(data, source=str(path))
+        raise error(f"{path}: not valid JSON (nested too deeply)") from None
 
 
 def read_top(path: str | Path) -> TOPInstance:

@@ -32,7 +32,7 @@ from pathlib import Path
 
 from sarcover.formulations.errors import SarcoverError
 from sarcover.formulations.instance import TOPInstance
-from sarcover.formulations.io import read_text_file
+from sarcover.formulations.io import read_json_file
 from sarcover.formulations.limits import shown
 from sarcover.formulations.plan import Plan
 
@@ -126,13 +126,4 @@ def plan_from_dict(data, instance: TOPInstance | None = None, source: str = "pla
 def load_plan(path: str | Path, instance: TOPInstance | None = None) -> PlanFile:
     """Read and validate the plan file at ``path`` (against ``instance`` if given)."""
     path = Path(path)
-    text = read_text_file(path, PlanFileError, "a plan file")
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise PlanFileError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
-    except ValueError as exc:  # e.g. an integer of more digits than Python converts
-        raise PlanFileError(f"{path}: not valid JSON ({str(exc).splitlines()[0][:80]})") from None
-    except RecursionError:
-        raise PlanFileError(f"{path}: not valid JSON (nested too deeply)") from None
-    return plan_from_dict(data, instance, source=str(path))
+    return plan_from_dict(read_json_file(path, PlanFileError, "a plan file"), instance, source=str(path))
