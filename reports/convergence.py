@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from sarcover.formulations.history import stop_reason_of
-from sarcover.reports.plots import _new_axes, save_figure, subplots
+from sarcover.reports.plots import new_axes, save_figure, subplots
 from sarcover.reports.style import look, ordered
 
 THRESHOLDS = (0.05, 0.01, 0.0)  # mean gaps whose first time the table gives
@@ -227,7 +227,7 @@ def plot_convergence(runs: pd.DataFrame, clock: str = "wall", ax=None, title: st
     time of its runs was measured to. Draws on ``ax`` (a new one if None) and returns it; neither
     shows nor saves."""
     if ax is None:
-        ax = _new_axes((7, 4.5))
+        ax = new_axes((7, 4.5))
     limit = float(runs["limit"].max())
     for method in ordered(runs["method"].unique()):
         grp = runs[runs["method"] == method]

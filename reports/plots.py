@@ -35,7 +35,7 @@ def save_figure(fig, path, dpi: int = 110) -> None:
         plt.close(fig)
 
 
-def _new_axes(figsize):
+def new_axes(figsize):
     """Axes of a new pyplot figure, in the caller's backend (for ``ax=None``)."""
     import matplotlib.pyplot as plt
 
@@ -48,7 +48,7 @@ def plot_plan(instance: TOPInstance, plan: Plan | None, ax=None, title: str | No
     The legend sits to the right of the axes; ``legend=False`` leaves it to the caller (one for a
     figure of panels: :func:`plan_legend`)."""
     if ax is None:
-        ax = _new_axes((7, 7))
+        ax = new_axes((7, 7))
     visited = set(plan.visited) if plan is not None else set()
     mask = np.array([i in visited for i in range(instance.n_nodes)], dtype=bool)
     pts = instance.coords
@@ -106,7 +106,7 @@ def plot_anytime(series: dict, ax=None, title: str | None = None, reference: flo
     (0) does not flatten the curves; it enters from below.
     """
     if ax is None:
-        ax = _new_axes((6.5, 4.2))
+        ax = new_axes((6.5, 4.2))
     lows, highs, t_max, used = [], [], 0.0, {}
     for method, points in series.items():
         c = used[method] = (colors or {}).get(method, look(method).color)

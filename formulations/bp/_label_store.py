@@ -9,7 +9,7 @@ words.
 The searches call these in their innermost loops, so they pass what costs nothing to pass:
 :func:`extend`, called once per arc, takes scalars only, and the per-label functions return no
 arrays; arrays passed per arc, or returned per label, slow the searches down measurably
-(docs/bp-log.md, 2026-12-05, the label store).
+(docs/bp-log.md, "the label store").
 """
 
 from __future__ import annotations
