@@ -105,16 +105,23 @@ class ColumnGeneration:
                 allowed &= prof > 1e-12
             y0 = float(y[0])
             res = pricer.price(cost, ret, prof, allowed, heuristic=True, y0=y0, sig=sig)
-            if m.add_routes(pricer.columns(res)):
+            bound = self._relaxed_bound(y, res, bound, root is not None)
+            if s.prunable(bound):
+                return bound, x, xa, True  # the relaxed bound proves (or prunes) already
+            added = m.add_routes(pricer.columns(res))
+            if root is not None and root.slow_to_settle():
+                continue  # a plan now, its routes in the LP (checked here too: at hundreds
+                # of points the heuristic pricing alone can take the whole limit)
+            if added:
                 continue
             if s.clock.time_left() <= 0:
                 return bound, x, xa, False
-            if root is not None and root.slow_to_settle():
-                continue  # a plan now, its routes in the LP
             # below the root the exact pricing is targeted; the root's LP is converged
             gain = y0 + (self.slack(m.lagrangian_bound(y, y0)) if root is None else 0.0)
             res = pricer.exact(cost, ret, prof, allowed, gain, sig)
             s.stats.exact_pricings += 1
+            if not res.exact:
+                bound = self._relaxed_bound(y, res, bound, root is not None)
             if not res.exact and s.clock.time_left() > 0:
                 # the label cap, not the clock: no bound from this call. Under the last cut
                 # round's cuts, withdraw them and go on; otherwise the node stays unconverged
@@ -151,6 +158,21 @@ class ColumnGeneration:
             if root is not None and root.add_cuts(state, x, y, value):
                 continue
             return bound, x, xa, True
+
+    def _relaxed_bound(self, y, res, bound: float, at_root: bool) -> float:
+        """The node's bound after a pricing call that may not have finished (heuristic, label
+        cap, clock): the Lagrangian bound of the duals ``y`` with the call's relaxed best path
+        (:attr:`.labelling.PricingResult.relaxed`), when lower. This is what certifies a bound
+        when exact pricing cannot finish (hundreds of points at K = 6)."""
+        if not np.isfinite(res.relaxed):
+            return bound
+        lag = self.search.master.lagrangian_bound(y, res.relaxed)
+        if lag < bound - TOL:
+            self.search.stats.relaxed_bounds += 1
+            bound = lag
+            if at_root:
+                self.search.log(bound)
+        return bound
 
     def slack(self, dual_value: float) -> float:
         """Targeted pricing: how much the best route's reduced prize may exceed the vehicle dual

@@ -356,17 +356,21 @@ def _join(fnode, fen, fpr, fmask, falive, fsr, bnode, ben, bpr, bmask, bsr, bsta
 class PricingResult:
     """Outcome of one pricing call: the best reduced prize over the searched path set, whether
     that value is proven (exact search over a relaxation of the elementary routes), and the
-    improving elementary routes found (solver indices, without start and end)."""
+    improving elementary routes found (solver indices, without start and end). ``relaxed``: an
+    upper bound on the best elementary path's reduced prize that holds whether or not the search
+    finished (the suffix tables' best walk from the start, :func:`.bounds.suffix_dp`, cut duals
+    left unpaid); +inf when the tables are off."""
 
-    __slots__ = ("best", "exact", "routes", "cycles", "n_labels", "ng_routes")
+    __slots__ = ("best", "exact", "routes", "cycles", "n_labels", "ng_routes", "relaxed")
 
-    def __init__(self, best, exact, routes, cycles, n_labels, ng_routes=()):
+    def __init__(self, best, exact, routes, cycles, n_labels, ng_routes=(), relaxed=np.inf):
         self.best = best
         self.exact = exact
         self.routes = routes
         self.cycles = cycles
         self.n_labels = n_labels
         self.ng_routes = ng_routes
+        self.relaxed = relaxed
 
 
 def label_table(cost, profit, budget, ng, allowed, threshold, max_labels, deadline, delta, nb,
@@ -445,10 +449,11 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     end = n - 1
     half = budget / 2.0 if bidirectional else budget
     order, cin, reach, lastord, cend = completion_data(cost, ret, profit, allowed)
+    tables = suffix_tables(cost, profit, allowed, budget)
     count, node, pred, en, pr, fmask, falive, hit, thr, fsr = label_search(
         cost, ret, profit, budget, ng, allowed, heuristic, max_labels, order, cin, reach,
         lastord, cend, float(min_gain), float(deadline), half, cmem, mmem, sig,
-        *suffix_tables(cost, profit, allowed, budget), float(keep), nsub,
+        *tables, float(keep), nsub,
     )
     total = int(count)
     found = []  # (value, path)
@@ -509,4 +514,16 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
                     if u in last:
                         cycles.append(tuple(path[last[u] : pos + 1]))
                     last[u] = pos
-    return PricingResult(best, (not hit) and (not heuristic), routes, cycles, total, ng_routes)
+    return PricingResult(best, (not hit) and (not heuristic), routes, cycles, total, ng_routes,
+                         relaxed_best(*tables, budget))
+
+
+def relaxed_best(g1, s1, g2, delta, nb, budget) -> float:
+    """Upper bound on the best elementary path's reduced prize from the suffix tables
+    (:func:`.bounds.suffix_dp`): the best 2-cycle-free walk from the start within the budget,
+    arcs rounded down to whole units, cut duals left unpaid (they only lower a path's prize).
+    It holds whatever the labelling did, so a heuristic or capped call still certifies a
+    Lagrangian bound with it, a weaker one. +inf when the tables are off (``nb`` = 0)."""
+    if nb == 0:
+        return np.inf
+    return max(0.0, float(dp_bound(g1, s1, g2, 0, -1, float(budget), delta, nb)))

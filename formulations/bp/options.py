@@ -85,6 +85,11 @@ class BPOptions:
       columns per call, more labels (:func:`.labelling.price`); 0 prunes against the best, 1
       never raises the threshold. 0.5: fewer exact calls at the root, more cut rounds in time
       (docs/bp.md).
+    - ``sparse_arcs``, ``sparse_from``: from ``sparse_from`` points on (beyond the paper's
+      grid), the heuristic pricing runs on each point's ``sparse_arcs`` cheapest arcs
+      (:func:`.graph.sparse_graph`); its routes are routes of the full graph, and the exact
+      pricing and every bound stay on the full graph. 0 arcs: never.
+    - ``heuristic_columns``: the most routes one heuristic pricing call returns.
     - ``ng_cap``: the most points an ng set grows to when LP routes repeat a point.
     - ``exact_labels``: an exact pricing call gives up beyond this many labels (memory: about
       100 bytes each). Such a call certifies no bound: at the root the last cut round is
@@ -112,6 +117,10 @@ class BPOptions:
       two-vehicle files the root's column generation can take the whole limit, and without the
       heuristic the plan is only what the MILP over the generated routes finds (p4.2.r: 1115
       against a best known 1292).
+    - ``primal_first_from``: from this many points on (beyond the paper's grid) the first call
+      runs before the root's column generation: there the root takes most of the limit, the
+      warm start (greedy) lies far below what PyVRP finds in seconds, and the LP starts from
+      the heuristic's routes.
     - ``primal_share``, ``primal_cap_s``: time for each call of the caller's ``primal``
       heuristic, at most ``primal_cap_s`` seconds. 30 s: on
       M = 20, K = 5-6 a 30 s PyVRP search found plans one better than bp's (10 s) on about a
@@ -158,6 +167,10 @@ class BPOptions:
     ng_columns: bool = _opt(True, "improving ng-routes that repeat a point also enter the master")
     exact_keep: float = _opt(0.5, "exact pricing keeps routes within this share of the best route's gain (0: "
                                   "prune against the best)", 0, 1)
+    sparse_arcs: int = _opt(16, "from sparse_from points on, heuristic pricing keeps each point's this many "
+                                "cheapest arcs (0: full graph)", 0)
+    sparse_from: int = _opt(150, "points from which heuristic pricing runs on the sparse graph", 0)
+    heuristic_columns: int = _opt(30, "most routes one heuristic pricing call returns", 1)
     ng_cap: int = _opt(12, "most points an ng set grows to", 1)
     exact_labels: int = _opt(2_000_000, "an exact pricing call gives up beyond this many labels (about 100 "
                                         "bytes each)", 1)
@@ -170,6 +183,8 @@ class BPOptions:
     cut_share: float = _opt(0.35, "cut rounds start only within this share of the time limit", 0, 1)
     primal_calls: int | None = _opt(None, "most calls of the primal heuristic (PyVRP) at the root; none: 2, "
                                           "or 4 from 600 s", 0)
+    primal_first_from: int = _opt(150, "from this many points on, the first primal call runs before the root's "
+                                       "column generation", 0)
     primal_share: float = _opt(0.1, "time of each primal heuristic call, as a share of the time limit", 0, 1)
     primal_late_share: float = _opt(0.5, "run the first primal call once this share of the limit is used if "
                                          "the root is still open", 0, 1)

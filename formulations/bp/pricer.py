@@ -8,7 +8,9 @@ import time
 from typing import TYPE_CHECKING
 
 from sarcover.formulations.bp.constants import TOL
-from sarcover.formulations.bp.labelling import price, sub_buckets
+from sarcover.formulations.bp.bounds import suffix_tables
+from sarcover.formulations.bp.graph import cheapest_return, sparse_graph
+from sarcover.formulations.bp.labelling import price, relaxed_best, sub_buckets
 
 if TYPE_CHECKING:
     from sarcover.formulations.bp.search import Search
@@ -17,11 +19,17 @@ if TYPE_CHECKING:
 class Pricer:
     """Pricing calls of one run. ``bidirectional``: the exact pricing direction; None until the
     first exact call has measured both. ``keep``: the exact calls' share of near-best routes
-    (:func:`.labelling.price`); ``exact_labels``: their label cap."""
+    (:func:`.labelling.price`); ``exact_labels``: their label cap. From ``sparse_from`` points
+    on, the heuristic calls run on the ``sparse_arcs`` cheapest arcs out of each point
+    (:func:`.graph.sparse_graph`; 0: never) and return up to ``heuristic_columns`` routes."""
 
     def __init__(self, search: "Search", bidirectional: bool | None, ng_columns: bool,
-                 keep: float, exact_labels: int):
+                 keep: float, exact_labels: int, *, sparse_arcs: int = 0, sparse_from: int = 0,
+                 heuristic_columns: int = 30):
         self.search = search
+        self.sparse_arcs = sparse_arcs
+        self.sparse_from = sparse_from
+        self.heuristic_columns = heuristic_columns
         self.bidirectional = bidirectional
         self.ng_columns = ng_columns
         self.keep = keep
@@ -37,13 +45,21 @@ class Pricer:
         t = time.perf_counter()
         # an exact call makes about as many labels as the one before it: its sub-buckets follow
         nsub = None if heuristic else sub_buckets(cost.shape[0], self.last_exact_labels)
+        full = cost
+        sparse = heuristic and self.sparse_arcs and cost.shape[0] - 2 >= self.sparse_from
+        if sparse:
+            cost = sparse_graph(cost, allowed, self.sparse_arcs)
+            ret = cheapest_return(cost)
         res = price(cost, ret, prof, s.problem.budget, s.ng, allowed, heuristic=heuristic,
                     max_labels=200_000 if heuristic else self.exact_labels,
-                    n_cols=30 if heuristic else 60, min_gain=y0 + TOL,
+                    n_cols=self.heuristic_columns if heuristic else 60, min_gain=y0 + TOL,
                     deadline=s.clock.deadline if deadline is None else deadline,
                     bidirectional=bool(self.bidirectional) and not heuristic,
                     cut_members=s.master.cut_members, cut_memory=s.master.cut_memory,
                     cut_duals=sig, keep=0.0 if heuristic else self.keep, nsub=nsub)
+        if sparse:  # the relaxed bound is over the full graph's routes, not the sparse one's
+            res.relaxed = relaxed_best(*suffix_tables(full, prof, allowed, s.problem.budget),
+                                       s.problem.budget)
         s.stats.pricing_s += time.perf_counter() - t
         if not heuristic:
             self.last_exact_labels = res.n_labels

@@ -72,12 +72,15 @@ class Root:
 
     # -- the root ---------------------------------------------------------------------------
     def solve(self, state: NodeState, bound: float):
-        """The root's column generation, then, once its LP is solved: tighter arc bounds by
+        """At scale (``primal_first_from`` points on) the caller's heuristic first; the root's
+        column generation, then, once its LP is solved: tighter arc bounds by
         labelling (and the root again on the smaller graph if they remove arcs: its bound may
         now prove the plan) and a dive from the final root LP (the first dive ran before the ng
         sets grew), then the caller's heuristic once more if the proof is still open. Returns
         what :meth:`.colgen.ColumnGeneration.solve` does."""
         s, m, elim = self.search, self.search.master, self.elimination
+        if s.problem.V >= s.options.primal_first_from:
+            self.incumbents.call_primal()  # at scale: a good plan and its routes first
         bound, x, xa, converged = self.colgen.solve(state, bound)
         if converged and not s.prunable(bound):
             version = elim.version

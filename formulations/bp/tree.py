@@ -52,7 +52,9 @@ class BranchAndPrice:
             return f * s.clock.limit if math.isfinite(s.clock.limit) else 30.0
 
         self.pricer = Pricer(s, opts.bidirectional, opts.ng_columns, opts.exact_keep,
-                             opts.exact_labels)
+                             opts.exact_labels, sparse_arcs=opts.sparse_arcs,
+                             sparse_from=opts.sparse_from,
+                             heuristic_columns=opts.heuristic_columns)
         self.elimination = Elimination(s, elim_limit=share(opts.elim_share),
                                        pool_routes=opts.pool_routes)
         self.incumbents = IncumbentSearch(

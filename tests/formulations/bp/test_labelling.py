@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bp_cases import brute_paths, cut_priced, random_cuts, tiny_pricing
+from bp_cases import branch_like, brute_paths, cut_priced, random_cuts, tiny_pricing
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -146,3 +146,23 @@ def test_sub_buckets_follow_the_expected_labels_per_point():
     assert counts[0] == NSUB_RANGE[0] and counts[-1] == NSUB_RANGE[1]
     assert sub_buckets(102, 10**8) * 102 <= SUB_CELLS
     assert sub_buckets(5000, 10**8) == SUB_CELLS // 5000
+
+
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("heuristic,max_labels", [(True, 200_000), (False, 3), (False, 10**6)])
+def test_relaxed_best_bounds_every_elementary_path_however_the_call_ended(seed, heuristic, max_labels):
+    """A pricing call's ``relaxed`` value is never below the best elementary path's reduced prize
+    (enumerated), whether the call was heuristic, stopped at its label cap or finished, also on
+    a graph with forbidden arcs and no triangle inequality."""
+    from sarcover.formulations.bp.labelling import price
+    from sarcover.formulations.bp.ng_sets import nearest_ng
+
+    cost, ret, profit, budget = tiny_pricing(seed)
+    if seed >= 2:
+        branch_like(cost, 200 + seed)
+    n = cost.shape[0]
+    best = max([p for p, _ in brute_paths(cost, profit, budget)] or [0.0])
+    res = price(cost, ret, profit, budget, nearest_ng(cost, 3), np.ones(n, dtype=bool),
+                heuristic=heuristic, max_labels=max_labels, n_cols=10, min_gain=0.0)
+    assert np.isfinite(res.relaxed)
+    assert res.relaxed >= best - 1e-9

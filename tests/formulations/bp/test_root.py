@@ -186,3 +186,20 @@ def test_root_out_of_time_right_after_the_route_pool_joined():
     proven, bound = bp.run()
     assert pool_added[-1] > 0  # the pool did add columns after the root LP
     assert not proven and bound >= OPTIMAL["p2.2.k"] - 1e-6
+
+
+def test_at_scale_the_heuristic_runs_before_the_roots_column_generation():
+    """From primal_first_from points on, the caller's heuristic runs before the root's first
+    LP (no round solved yet); below it, not before the root has priced."""
+    from sarcover.formulations.bp.tree import BranchAndPrice
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
+
+    inst = to_top(generate(6, 2, 2, 1))
+    for first_from, before_any_round in [(0, True), (10**6, False)]:
+        seen = []
+        bp = BranchAndPrice(inst, time_limit=20, primal=lambda s: seen.append(bp.search.stats.rounds),
+                            options=BPOptions(primal_first_from=first_from, primal_late_share=1.0,
+                                              cut_rounds=0))
+        bp.run()
+        assert (seen[:1] == [0]) == before_any_round
