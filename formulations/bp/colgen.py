@@ -129,7 +129,9 @@ class ColumnGeneration:
                 m.add_routes(pricer.columns(res))
                 if root is not None and root.label_cap():
                     continue
-                return bound, x, xa, False
+                # the LP solution stays the node's, its new columns at 0 (the caller reads
+                # x against every column the master holds now)
+                return bound, np.concatenate([x, np.zeros(m.n_routes - len(x))]), xa, False
             if res.exact:
                 lag = m.lagrangian_bound(y, res.best)
                 bound = min(bound, lag)

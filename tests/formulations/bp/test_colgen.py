@@ -60,3 +60,29 @@ def test_relaxed_bound_certifies_when_no_exact_pricing_finishes():
     assert r.info["exact_pricings"] >= 1 and r.info["relaxed_bounds"] >= 1
     assert r.bound >= optimum - 1e-6
     assert verify(inst, r.plan).valid and plan_prize(inst, r) <= optimum + 1e-9
+
+
+def test_label_cap_that_brings_new_routes_leaves_the_lp_solution_readable():
+    """An exact pricing stopped by its label cap whose routes join the master (at 600 points it
+    finds many before the cap): the node is branched on its LP solution, which covers every
+    column the master now holds (new ones at 0), instead of failing on the length (scale
+    suite, M = 100, K = 6: 'shapes not aligned'). The run ends with a valid plan and bound."""
+    from sarcover.formulations.bp.labelling import PricingResult
+    from sarcover.formulations.bp.tree import BranchAndPrice
+
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    bp = BranchAndPrice(inst, time_limit=20, options=BPOptions(cut_rounds=0))
+    exact, capped = bp.pricer.exact, []
+
+    def capped_with_new_routes(*args):
+        res = exact(*args)
+        if not capped and res.routes:
+            capped.append(len(res.routes))
+            return PricingResult(res.best, False, res.routes, [], res.n_labels, res.ng_routes)
+        return res
+
+    bp.pricer.exact = capped_with_new_routes
+    proven, bound = bp.run()
+    assert capped and bp.search.stats.label_caps == 1 and bp.search.stats.nodes > 1
+    assert bound >= OPTIMAL["p2.2.k"] - 1e-6
+    assert bp.search.incumbent_value <= OPTIMAL["p2.2.k"] + 1e-9
