@@ -26,15 +26,16 @@ decomposition     ~12 min   clustering / cross-cluster / routing loss of the pap
                             paper-opt's optima, at N=5 K=3, N=5 K=6 and K=3 N=2..6 (one instance per
                             worker; 755 of its 960 rows took 9.3 min on 2)
 top-4-7           2.6 h     bp alone at 600 s on the 192 shipped files of TOP sets 4-7 (5.2 CPU-hours)
-paper-validation  ~1.6 h    bp alone on the paper grid with paper-opt's limits, 20 held-out instances per
+paper-validation  2.3 h     bp alone on the paper grid with paper-opt's limits, 20 held-out instances per
                             setting (seeds 200..219, which chose no setting): its proof rates beside
                             paper-opt's, which are tuning figures (about paper-opt's bp part)
-scale             ~8 h      M=20..100 at K=3 and 6 (60-600 viewpoints), 10 instances each: every method
+scale             ~3.5 h    M=20..100 at K=3 and 6 (60-600 viewpoints), 10 instances each: every method
                             against bp (60 s at K=3, 600 s at K=6; milp and cpsat only at M<=40);
-                            bp's 40 K=6 jobs at 600 s dominate (docs/scale.md)
+                            bp's 40 K=6 jobs at 600 s dominate; one instance per setting took 42 min
+                            on 1 worker (docs/scale.md)
 ================  ========  =========================================================================
 
-In all about 16 h on 2 cores, half of it scale (``--skip scale --skip paper-validation``: about 6 h).
+In all about 12 h on 2 cores (``--skip scale --skip paper-validation``: about 6 h).
 ``--runs R`` sets the random instances per setting of paper-n and paper-k (the paper: 1000, the
 default); ``--skip STEP`` leaves a suite or the decomposition out; ``--report-only`` only rewrites
 the report. Every step resumes: a stopped run continues where it stopped. The results directory
