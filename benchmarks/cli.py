@@ -51,7 +51,7 @@ class _Parser(argparse.ArgumentParser):
         raise CLIError(f"{where}: {message}" if where else message)
 
 
-def _positive_float(text: str) -> float:
+def positive_float(text: str) -> float:
     try:
         value = float(text)
     except ValueError:
@@ -61,7 +61,7 @@ def _positive_float(text: str) -> float:
     return value
 
 
-def _int_at_least(minimum: int, maximum: int | None = None):
+def int_at_least(minimum: int, maximum: int | None = None):
     def parse(text: str) -> int:
         try:
             value = int(text)
@@ -123,16 +123,16 @@ def _add_generate(sub):
     from sarcover.formulations.generate import PRESETS
 
     p = sub.add_parser("generate", help="draw a random SAR instance (targets uniform in 2000 m × 2000 m)")
-    p.add_argument("--targets", "-M", type=_int_at_least(1), required=True, help="number of targets M")
-    p.add_argument("--views", "-K", type=_int_at_least(1), required=True, help="views per target K")
-    p.add_argument("--uavs", "-N", type=_int_at_least(1), required=True, help="number of UAVs N")
-    p.add_argument("--seed", type=_int_at_least(0, MAX_SEED), default=0, help="random seed (default 0)")
+    p.add_argument("--targets", "-M", type=int_at_least(1), required=True, help="number of targets M")
+    p.add_argument("--views", "-K", type=int_at_least(1), required=True, help="views per target K")
+    p.add_argument("--uavs", "-N", type=int_at_least(1), required=True, help="number of UAVs N")
+    p.add_argument("--seed", type=int_at_least(0, MAX_SEED), default=0, help="random seed (default 0)")
     p.add_argument("--preset", choices=sorted(PRESETS), default="paper", help="parameter preset")
-    p.add_argument("--altitude", type=_positive_float, help="override H (m)")
+    p.add_argument("--altitude", type=positive_float, help="override H (m)")
     p.add_argument("--pitch-deg", type=float, help="override θ (degrees)")
-    p.add_argument("--e-fly", type=_positive_float, help="override E_F (energy per metre)")
-    p.add_argument("--e-image", type=_positive_float, help="override E_I (energy per viewpoint)")
-    p.add_argument("--e-max", type=_positive_float, help="override E_max (energy budget per UAV)")
+    p.add_argument("--e-fly", type=positive_float, help="override E_F (energy per metre)")
+    p.add_argument("--e-image", type=positive_float, help="override E_I (energy per viewpoint)")
+    p.add_argument("--e-max", type=positive_float, help="override E_max (energy budget per UAV)")
     p.add_argument("-o", "--output", required=True, help="output JSON file")
     p.set_defaults(func=_cmd_generate)
 
@@ -217,9 +217,9 @@ def _add_solve(sub):
     p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                    help="a parameter of the method (repeatable; VALUE is a TOML literal such as 300, 0.5, "
                         "true or \"text\"; `sarcover methods NAME` lists them)")
-    p.add_argument("--time-limit", type=_positive_float, default=DEFAULT_TIME_LIMIT,
+    p.add_argument("--time-limit", type=positive_float, default=DEFAULT_TIME_LIMIT,
                    help=f"seconds (default {DEFAULT_TIME_LIMIT:g})")
-    p.add_argument("--seed", type=_int_at_least(0, MAX_SEED), default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=int_at_least(0, MAX_SEED), default=0, help="random seed (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", help="write a picture of the plan (paper's Fig. 2 style; PNG unless the name says "
                                   "pdf, svg, ...)")
@@ -357,10 +357,10 @@ def _add_bench(sub):
     p.add_argument("suite", nargs="?", default="quick", help=f"built-in suite ({', '.join(builtin_suites())}) "
                    "or a suite TOML file (default quick)")
     p.add_argument("-o", "--output", help="results directory (default results/<suite>)")
-    p.add_argument("--workers", type=_int_at_least(1), help="parallel worker processes (default: all cores)")
+    p.add_argument("--workers", type=int_at_least(1), help="parallel worker processes (default: all cores)")
     p.add_argument("--resume", action="store_true", help="continue a run: skip jobs already stored")
-    p.add_argument("--runs", type=_int_at_least(1), help="random instances per setting (replaces the suite's runs)")
-    p.add_argument("--methods", type=_method_list, help="run only these of the suite's methods, comma-separated")
+    p.add_argument("--runs", type=int_at_least(1), help="random instances per setting (replaces the suite's runs)")
+    p.add_argument("--methods", type=method_list, help="run only these of the suite's methods, comma-separated")
     p.add_argument("--scheduler", help="run on a Dask cluster, e.g. tcp://HOST:8786")
     p.add_argument("--tls-ca-file", metavar="PEM", help="with --scheduler tls://...: the CA certificate that "
                    "signed the cluster's certificates")
@@ -372,7 +372,7 @@ def _add_bench(sub):
     p.set_defaults(func=_cmd_bench)
 
 
-def _method_list(text: str) -> list[str]:
+def method_list(text: str) -> list[str]:
     from sarcover.benchmarks.params import split_top
 
     names = [n.strip() for n in split_top(text)]  # a variant's own commas stay inside its brackets

@@ -3,7 +3,7 @@ Dask worker process killed mid-run costs.
 
 Why: the harness runs a suite on the local pool or on a Dask cluster (README, "On a Dask cluster")
 and claims that Dask costs about nothing per job and that a killed worker loses no job. This tool
-puts numbers on both for a given suite, on this machine (issue 39)::
+puts numbers on both for a given suite, on this machine::
 
     python -m sarcover.benchmarks.cluster_timing SUITE -o OUTDIR [--runs R] [--methods A,B]
                                                  [--workers N] [--kill-after SECONDS]
@@ -515,39 +515,19 @@ class _Parser(argparse.ArgumentParser):
         raise TimingError(message)
 
 
-def _positive(kind):
-    def parse(text: str):
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"not a number: {text[:40]!r}") from None
-        if not (math.isfinite(value) and value > 0):
-            raise argparse.ArgumentTypeError(f"must be positive, got {text[:40]!r}")
-        return value
-
-    return parse
-
-
-def _methods(text: str) -> list[str]:
-    from sarcover.benchmarks.params import split_top
-
-    names = [n.strip() for n in split_top(text)]
-    if not all(names):
-        raise argparse.ArgumentTypeError(f"empty method name in {text!r}")
-    return names
-
-
 def build_parser() -> argparse.ArgumentParser:
+    from sarcover.benchmarks.cli import int_at_least, method_list, positive_float
+
     p = _Parser(prog=PROG, description="Time a suite on 1 local worker, N local workers and an N-process Dask "
                 "cluster started here, optionally with a Dask worker killed mid-run; write OUTDIR/timing.json "
                 "and print a Markdown table.")
     p.add_argument("suite", help="built-in suite name or suite TOML file")
     p.add_argument("-o", "--output", required=True, help="folder for the runs' results and timing.json")
-    p.add_argument("--runs", type=_positive(int), help="random instances per setting (replaces the suite's runs)")
-    p.add_argument("--methods", type=_methods, help="run only these of the suite's methods, comma-separated")
-    p.add_argument("--workers", type=_positive(int), default=2, help="N: local and Dask worker processes "
+    p.add_argument("--runs", type=int_at_least(1), help="random instances per setting (replaces the suite's runs)")
+    p.add_argument("--methods", type=method_list, help="run only these of the suite's methods, comma-separated")
+    p.add_argument("--workers", type=int_at_least(1), default=2, help="N: local and Dask worker processes "
                    "(default 2)")
-    p.add_argument("--kill-after", type=_positive(float), metavar="SECONDS", help="also run on Dask with one "
+    p.add_argument("--kill-after", type=positive_float, metavar="SECONDS", help="also run on Dask with one "
                    "worker process SIGKILLed mid-job once SECONDS have passed")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bars, warnings only")
     return p

@@ -9,7 +9,8 @@
   kept point costs at least its cheapest incoming arc, and one last arc into the end (the
   cheapest of a fitting point) is set aside first;
 * the suffix tables (:func:`suffix_dp`): the best prize of a 2-cycle-free walk from each point
-  to the end by energy, in whole units of the budget, looked up by :func:`dp_bound`.
+  to the end by energy, in whole units of the budget, looked up by :func:`dp_bound`; from the
+  start with the whole budget they bound a pricing call's best path (:func:`relaxed_best`).
 
 Both bound the best *elementary* suffix, which is all the pricing's value needs.
 """
@@ -140,6 +141,17 @@ def dp_bound(g1, s1, g2, u, v, room, delta, nb):
     if b < 0:
         return -np.inf
     return g1[u, b] if s1[u, b] != v else g2[u, b]
+
+
+def relaxed_best(g1, s1, g2, delta, nb, budget) -> float:
+    """Upper bound on the best elementary path's reduced prize from the suffix tables
+    (:func:`suffix_dp`): the best 2-cycle-free walk from the start within the budget,
+    arcs rounded down to whole units, cut duals left unpaid (they only lower a path's prize).
+    It holds whatever the labelling did, so a heuristic or capped call still certifies a
+    Lagrangian bound with it, a weaker one. +inf when the tables are off (``nb`` = 0)."""
+    if nb == 0:
+        return np.inf
+    return max(0.0, float(dp_bound(g1, s1, g2, 0, -1, float(budget), delta, nb)))
 
 
 def completion_data(cost, ret, profit, allowed):

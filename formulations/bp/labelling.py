@@ -58,7 +58,7 @@ from sarcover.formulations.bp._label_store import (chain, extend, grow, grow_sto
                                                    new_store, next_label, out_of_time,
                                                    write_label)
 from sarcover.formulations.bp.bounds import (completion_bound, completion_data, dp_bound,
-                                             suffix_tables)
+                                             relaxed_best, suffix_tables)
 from sarcover.formulations.bp.constants import EPS
 from sarcover.formulations.bp.cut_duals import cut_arrays, sigsum
 from sarcover.formulations.bp.graph import cheapest_return, reversed_graph
@@ -517,13 +517,3 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
     return PricingResult(best, (not hit) and (not heuristic), routes, cycles, total, ng_routes,
                          relaxed_best(*tables, budget))
 
-
-def relaxed_best(g1, s1, g2, delta, nb, budget) -> float:
-    """Upper bound on the best elementary path's reduced prize from the suffix tables
-    (:func:`.bounds.suffix_dp`): the best 2-cycle-free walk from the start within the budget,
-    arcs rounded down to whole units, cut duals left unpaid (they only lower a path's prize).
-    It holds whatever the labelling did, so a heuristic or capped call still certifies a
-    Lagrangian bound with it, a weaker one. +inf when the tables are off (``nb`` = 0)."""
-    if nb == 0:
-        return np.inf
-    return max(0.0, float(dp_bound(g1, s1, g2, 0, -1, float(budget), delta, nb)))

@@ -8,9 +8,9 @@ import time
 from typing import TYPE_CHECKING
 
 from sarcover.formulations.bp.constants import TOL
-from sarcover.formulations.bp.bounds import suffix_tables
+from sarcover.formulations.bp.bounds import relaxed_best, suffix_tables
 from sarcover.formulations.bp.graph import cheapest_return, sparse_graph
-from sarcover.formulations.bp.labelling import price, relaxed_best, sub_buckets
+from sarcover.formulations.bp.labelling import price, sub_buckets
 
 if TYPE_CHECKING:
     from sarcover.formulations.bp.search import Search
@@ -46,7 +46,7 @@ class Pricer:
         # an exact call makes about as many labels as the one before it: its sub-buckets follow
         nsub = None if heuristic else sub_buckets(cost.shape[0], self.last_exact_labels)
         full = cost
-        sparse = heuristic and self.sparse_arcs and cost.shape[0] - 2 >= self.sparse_from
+        sparse = heuristic and self.sparse_arcs and s.problem.V >= self.sparse_from
         if sparse:
             cost = sparse_graph(cost, allowed, self.sparse_arcs)
             ret = cheapest_return(cost)
