@@ -76,6 +76,21 @@ def test_proven_share_and_certified_gap_per_setting():
     assert r["bp_time_limit"] == "600" and r["conflicts"] == 0
 
 
+def test_tuning_instances_counted_and_left_out_of_the_held_out_gap():
+    """A setting whose open instance chose bp's settings: the certified gap over all instances
+    includes it, the held-out one does not; settings without a tuning instance have both equal."""
+    rows = scale_rows(settings=[(40, 6, 10), (60, 6, 15)], runs=3, open_every=2)
+    assert "sar-m40-k6-n10-s300" in scale.TUNING  # seed 300: the open one (open_every=2)
+    st = setting_table(pd.DataFrame(rows)).set_index("setting")
+    r = st.loc["M=40 K=6 N=10"]
+    assert r["tuning"] == 1 and r["certified_gap_max"] == pytest.approx(4 / 194)
+    assert r["held_out_gap_max"] == pytest.approx(4 / 194)  # seed 302 is open too, and held out
+    assert r["held_out_gap_mean"] == pytest.approx(4 / 194 / 2)  # seeds 301 (proven) and 302
+    assert r["certified_gap_mean"] == pytest.approx(2 * 4 / 194 / 3)
+    other = st.loc["M=60 K=6 N=15"]
+    assert other["tuning"] == 0 and other["held_out_gap_mean"] == pytest.approx(other["certified_gap_mean"])
+
+
 def test_gaps_to_optimum_and_to_bound_kept_apart():
     """Greedy's gap is to the optimum on proven instances and to the bound on open ones; the mean
     of both is marked as an upper bound, and its t interval follows stats.t_halfwidth."""
@@ -103,6 +118,7 @@ def test_section_text_figure_and_csvs(tmp_path, monkeypatch):
     for s in ("M=20 K=3 N=4", "M=100 K=3 N=16"):
         assert s in text
     assert "| M=40 K=3 N=8 | 120 | 4 | 600 | 2/4 (50 %) |" in text
+    assert "Tuning instances: " in text and "sar-m40-k6-n10-s300" in text
     assert "| greedy | ≤ " in text and "upper bound" in text
     [(name, fig)] = figures
     ax = fig.axes[0]
