@@ -96,7 +96,7 @@ class BranchAndPrice:
         trivial = float(s.problem.inst.prizes[s.problem.reachable[1 : s.problem.V + 1]].sum())
         heap = [self._node_key(trivial, 0, 0, root)]
         counter = 1
-        unresolved = []  # nodes we cannot split further (should not happen) with their bounds
+        unresolved = []  # nodes not split (nothing fractional in an unconverged LP) and their bounds
         last_milp_cols = 0
         proven = False
         while heap:
@@ -133,6 +133,12 @@ class BranchAndPrice:
                 if s.prunable(bound):
                     continue
             if inc.offer_if_integral(x, xa):
+                if converged:
+                    continue  # the node's LP optimum is a plan: the node is solved
+                # not converged (a label cap): the LP optimum over all routes is unknown, so an
+                # integral LP solution closes nothing (at 600 points the degenerate LP sits at
+                # the incumbent's routes); with nothing fractional to branch on, its bound stays
+                unresolved.append(bound)
                 continue
             lp_value = float(np.dot(m.route_prize, x[: m.n_routes]))
             children = branch(s, state, x, lp_value, opts.strong, opts.group_branching)

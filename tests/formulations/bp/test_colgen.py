@@ -86,3 +86,30 @@ def test_label_cap_that_brings_new_routes_leaves_the_lp_solution_readable():
     assert capped and bp.search.stats.label_caps == 1 and bp.search.stats.nodes > 1
     assert bound >= OPTIMAL["p2.2.k"] - 1e-6
     assert bp.search.incumbent_value <= OPTIMAL["p2.2.k"] + 1e-9
+
+
+def test_unconverged_node_with_an_integral_lp_solution_stays_open():
+    """A node whose column generation stopped unconverged (an exact pricing at its label cap)
+    while its restricted LP solution is integral: that solution is offered as a plan, but the
+    node is not solved, since the LP over all routes may be higher. The run must not report
+    the plan optimal (scale suite, M = 100, K = 6, seed 302: the degenerate LP sat at PyVRP's
+    routes, the capped root was closed as solved, and 499 was reported optimal under a root
+    bound of 594)."""
+    from sarcover.formulations.bp.tree import BranchAndPrice
+    from sarcover.formulations.plan import Plan
+
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    weak = Plan.of([[0]] + [[]] * (inst.n_vehicles - 1))  # a plan far below the optimum
+    assert verify(inst, weak).valid
+    bp = BranchAndPrice(inst, time_limit=20, warm_start=weak, options=BPOptions(cut_rounds=0))
+    m = bp.search.master
+
+    def capped_root(state, bound):  # the LP at the warm start's routes, pricing capped
+        x = np.zeros(m.n_routes)
+        x[m.routes.index((1,))] = 1.0
+        return bound, x, np.zeros(m.n_art), False
+
+    bp.root.solve = capped_root
+    proven, bound = bp.run()
+    assert not proven
+    assert bound >= OPTIMAL["p2.2.k"] - 1e-6
