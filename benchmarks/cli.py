@@ -4,7 +4,9 @@ Exit codes (README, "Exit codes"): 0 success (for ``solve``: a verified plan cam
 input, with one line on stderr naming the problem; ``solve`` only: 3 no plan (``infeasible``, or
 ``no_plan`` / ``time_limit`` without a plan), 4 the method failed (``error``); ``verify`` 1 for an
 invalid plan; ``bench --strict`` 1 when a job of the suite ended in ``error``; ``report --strict`` 1
-when the report lists a conflict; 130 interrupted. Messages go through
+when the report lists a conflict; 130 interrupted (Ctrl-C, or SIGTERM as ``kill`` and batch
+schedulers send it: a ``bench`` run stops as on Ctrl-C, its stored rows and its runs.jsonl record
+kept). Messages go through
 ``logging.getLogger("sarcover")`` to stderr (:func:`setup_logging`; ``-v``/``-q``).
 A reader that closes stdout early (``| head``) ends the output quietly; the exit code stays the
 command's.
@@ -18,8 +20,10 @@ import json
 import logging
 import math
 import os
+import signal
 import sys
 import textwrap
+import threading
 from pathlib import Path
 
 from sarcover.benchmarks.methods import DEFAULT_TIME_LIMIT
@@ -577,9 +581,25 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _terminated(signum, frame):
+    """SIGTERM (``kill``, a batch scheduler's stop) ends a command as Ctrl-C does."""
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
     global _stdout_gone
     _stdout_gone = False
+    previous = None
+    if threading.current_thread() is threading.main_thread():  # signals reach the main thread only
+        previous = signal.signal(signal.SIGTERM, _terminated)
+    try:
+        return _main(argv)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _main(argv: list[str] | None) -> int:
     try:
         args = build_parser().parse_args(argv)
         setup_logging(args.verbose, args.quiet)

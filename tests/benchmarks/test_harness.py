@@ -217,3 +217,36 @@ def test_a_failed_jobs_row_holds_its_whole_traceback(tmp_path):
     assert tb[0].startswith("Traceback") and tb[-1] == "RuntimeError: boom"
     assert any("registry.py" in line and "run_method" in line for line in tb)
     assert any("bench_methods.py" in line and "crash" in line for line in tb)
+
+
+def test_sigterm_stops_a_run_as_ctrl_c_does(tmp_path):
+    """``kill`` (SIGTERM) on a running ``bench``: exit 130, the stored rows and an interrupted
+    runs.jsonl record kept."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    tests = Path(__file__).resolve().parents[1]
+    body = ('methods = ["greedy", "bench_methods:hang"]\ntime_limit = 60\n'
+            '[[instances]]\nM = 2\nK = 2\nN = 1\nruns = 1\n')
+    suite = write_suite(tmp_path, body)
+    out = tmp_path / "res"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tests), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.Popen([sys.executable, "-m", "sarcover.benchmarks.cli", "bench", str(suite), "-o", str(out),
+                             "--workers", "1", "--quiet"], env=env, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not ((out / "results.jsonl").exists() and (out / "results.jsonl").read_text().strip()):
+            assert time.monotonic() < deadline and proc.poll() is None
+            time.sleep(0.1)
+        time.sleep(0.5)  # the hanging job has started
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=30) == 130
+    finally:
+        proc.kill()
+    assert "interrupted" in proc.stderr.read()
+    assert [r["method"] for r in rows_of(out)] == ["greedy"]
+    records = [json.loads(line) for line in (out / "runs.jsonl").read_text().splitlines()]
+    assert len(records) == 1 and records[0]["interrupted"] is True and records[0]["jobs"] == 1
