@@ -15,6 +15,7 @@ command's.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import errno
 import json
 import logging
@@ -582,21 +583,29 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _terminated(signum, frame):
-    """SIGTERM (``kill``, a batch scheduler's stop) ends a command as Ctrl-C does."""
     raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt():
+    """Within the block SIGTERM (``kill``, a batch scheduler's stop) raises KeyboardInterrupt, so
+    a command stops as on Ctrl-C (a bench run keeps its rows and records its part). Signals reach
+    the main thread only: elsewhere the block changes nothing."""
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _terminated)
+    try:
+        yield
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 def main(argv: list[str] | None = None) -> int:
     global _stdout_gone
     _stdout_gone = False
-    previous = None
-    if threading.current_thread() is threading.main_thread():  # signals reach the main thread only
-        previous = signal.signal(signal.SIGTERM, _terminated)
-    try:
+    with sigterm_as_interrupt():
         return _main(argv)
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
 
 
 def _main(argv: list[str] | None) -> int:

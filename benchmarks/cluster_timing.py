@@ -533,12 +533,8 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def _raise_interrupt(signum, frame):
-    raise KeyboardInterrupt
-
-
 def main(argv: list[str] | None = None) -> int:
-    from sarcover.benchmarks.cli import setup_logging
+    from sarcover.benchmarks.cli import setup_logging, sigterm_as_interrupt
 
     try:
         args = build_parser().parse_args(argv)
@@ -547,12 +543,9 @@ def main(argv: list[str] | None = None) -> int:
 
         suite = load_suite(args.suite, runs=args.runs, methods=args.methods)
         dask_command()  # no dask: say so before any run
-        previous = signal.signal(signal.SIGTERM, _raise_interrupt)  # SIGTERM stops the cluster too
-        try:
+        with sigterm_as_interrupt():  # SIGTERM stops the cluster too
             timing = measure(suite, Path(args.output), workers=args.workers, kill_after=args.kill_after,
                              progress=not args.quiet)
-        finally:
-            signal.signal(signal.SIGTERM, previous)
     except SarcoverError as exc:  # HarnessError and SuiteError too
         print(f"cluster_timing: error: {' '.join(str(exc).splitlines())}", file=sys.stderr)
         return EXIT_BAD_INPUT

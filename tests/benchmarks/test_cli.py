@@ -109,3 +109,20 @@ def test_a_name_too_long_for_the_file_system_is_bad_input(capsys):
         assert main(argv) == 2, argv
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and name in err[0] and "too long" in err[0], argv
+
+
+def test_sigterm_as_interrupt_raises_within_the_block_and_restores_after():
+    """The shared SIGTERM handling of the CLI and cluster_timing: KeyboardInterrupt inside the
+    block, the previous handler back after it."""
+    import os
+    import signal
+    import time
+
+    from sarcover.benchmarks.cli import sigterm_as_interrupt
+
+    before = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(KeyboardInterrupt):
+        with sigterm_as_interrupt():
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(1.0)  # the handler runs here, in the main thread
+    assert signal.getsignal(signal.SIGTERM) is before
