@@ -100,7 +100,27 @@ def seed_step(rows: Path, root: Path, step: str) -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = _Parser(prog="python -m sarcover.benchmarks.reproduce", description=__doc__.splitlines()[0])
+    """Run the steps, then write the report. Ctrl-C or SIGTERM stops it with exit code 130 and
+    loses nothing (every step resumes); a stored run that does not fit the suite (a changed
+    setting) is a one-line error with exit code 2."""
+    from sarcover.benchmarks.cli import EXIT_BAD_INPUT, EXIT_INTERRUPTED, sigterm_as_interrupt
+    from sarcover.formulations.errors import SarcoverError
+
+    prog = "python -m sarcover.benchmarks.reproduce"
+    with sigterm_as_interrupt():
+        try:
+            return _main(argv, prog)
+        except SarcoverError as exc:
+            print(f"{prog}: error: {' '.join(str(exc).splitlines())}", file=sys.stderr)
+            return EXIT_BAD_INPUT
+        except KeyboardInterrupt:
+            print(f"{prog}: interrupted; the rows so far are kept, the same command resumes",
+                  file=sys.stderr)
+            return EXIT_INTERRUPTED
+
+
+def _main(argv: list[str] | None, prog: str) -> int:
+    ap = _Parser(prog=prog, description=__doc__.splitlines()[0])
     ap.add_argument("--results", default="results/reference", help="results root (default results/reference)")
     ap.add_argument("--out", default="reports/reference", help="report directory (default reports/reference)")
     ap.add_argument("--runs", type=int, default=1000, help="instances per setting of paper-n/paper-k (default 1000)")

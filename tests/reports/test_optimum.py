@@ -324,3 +324,38 @@ def test_reproduce_resumes_from_committed_rows(tmp_path, capsys):
     assert exc.value.code == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "--resume-from" in err and "missing" in err
+
+
+def test_reproduce_stops_on_sigterm_and_names_a_bad_resume(tmp_path, monkeypatch, capsys):
+    """SIGTERM (a batch scheduler's stop) ends the reference run like Ctrl-C: exit 130 and one line
+    saying the same command resumes; a stored run that does not fit the suite is a one-line error
+    (exit 2), not a traceback. The previous SIGTERM handler is back afterwards."""
+    import os
+    import signal
+    import time
+
+    from sarcover.benchmarks import harness, reproduce
+    from sarcover.benchmarks.errors import HarnessError
+
+    def terminated(suite, out_dir, **kw):
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(10)  # the handler raises KeyboardInterrupt here
+        raise AssertionError("SIGTERM did not stop the run")
+
+    before = signal.getsignal(signal.SIGTERM)
+    monkeypatch.setattr(harness, "run_suite", terminated)
+    args = ["--results", str(tmp_path / "r"), "--out", str(tmp_path / "o"), "--quiet", "--runs", "1"]
+    assert reproduce.main(args) == 130
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "interrupted" in err and "resumes" in err
+    assert signal.getsignal(signal.SIGTERM) is before
+    assert not (tmp_path / "o" / "README.md").exists()  # no report from a stopped run
+
+    def refused(suite, out_dir, **kw):
+        raise HarnessError(f"{out_dir}: stored jobs ran with\nanother time limit")
+
+    monkeypatch.setattr(harness, "run_suite", refused)
+    assert reproduce.main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and err.startswith("python -m sarcover.benchmarks.reproduce: error:")
+    assert "another time limit" in err
