@@ -34,6 +34,7 @@ class Stats:
     cuts_withdrawn: int = 0  # removed because an exact pricing under them hit its label cap
     label_caps: int = 0  # exact pricings that hit their label cap (no exact bound from them)
     relaxed_bounds: int = 0  # node bounds lowered by a relaxed pricing bound (no exact pricing)
+    open_integral: int = 0  # unconverged nodes (label cap) with an integral LP: kept open, not solved
     arcs_eliminated: int = 0  # arcs no plan better than the incumbent can use
     elim_s: float = 0.0  # time spent on their bounds
     elim_labels: bool | None = None  # the labelling bound ran to the end (None: not tried)
@@ -75,7 +76,7 @@ class Stats:
             "open_nodes": self.open_nodes,
             "cuts": self.cuts, "cuts_purged": self.cuts_purged,
             "cuts_withdrawn": self.cuts_withdrawn, "label_caps": self.label_caps,
-            "relaxed_bounds": self.relaxed_bounds,
+            "relaxed_bounds": self.relaxed_bounds, "open_integral": self.open_integral,
             "arcs_eliminated": self.arcs_eliminated, "elim_s": round(self.elim_s, 3),
             "elim_labels": self.elim_labels, "pool_routes": self.pool_routes,
             "enum_tries": self.enum_tries, "enum_complete": self.enum_complete,

@@ -139,11 +139,13 @@ class BranchAndPrice:
                 # integral LP solution closes nothing (at 600 points the degenerate LP sits at
                 # the incumbent's routes); with nothing fractional to branch on, its bound stays
                 unresolved.append(bound)
+                s.stats.open_integral += 1
                 continue
             lp_value = float(np.dot(m.route_prize, x[: m.n_routes]))
             children = branch(s, state, x, lp_value, opts.strong, opts.group_branching)
             if children is None:
                 unresolved.append(bound)
+                s.stats.open_integral += 1
                 continue
             s.stats.group_branches += children[0].group_bounds != state.group_bounds
             for ch in children:
