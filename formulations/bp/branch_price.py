@@ -50,11 +50,17 @@ def _result(bp: BranchAndPrice, proven: bool, bound: float, info: dict, t0: floa
             return Result("bp", Termination.INFEASIBLE, bound=None, runtime_s=runtime, info=info,
                           reason="branch-and-price proved that no plan covers every group")
         b = bound if math.isfinite(bound) else None
+        if bp.stopped is not None:
+            return Result("bp", Termination.COMPLETED, bound=b, runtime_s=runtime, info=info,
+                          reason=f"stopped early, no plan covering every group: {bp.stopped}")
         return Result("bp", Termination.TIME_LIMIT, bound=b, runtime_s=runtime, info=info,
                       reason="time limit before a plan covering every group was found")
     if proven:
         return Result("bp", Termination.OPTIMAL, plan=plan, bound=s.incumbent_value, runtime_s=runtime,
                       info=info)
     b = bound if math.isfinite(bound) else None
+    if bp.stopped is not None:  # an LP HiGHS failed on ended the search: its plan and bound hold
+        return Result("bp", Termination.COMPLETED, plan=plan, bound=b, runtime_s=runtime, info=info,
+                      reason=f"stopped early: {bp.stopped}")
     return Result("bp", Termination.TIME_LIMIT, plan=plan, bound=b, runtime_s=runtime, info=info,
                   reason="time limit")

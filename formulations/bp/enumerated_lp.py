@@ -25,7 +25,7 @@ import highspy
 import numpy as np
 import scipy.sparse as sp
 from numba import njit
-from sarcover.formulations.bp.highs import INF, packing_milp, quiet_highs
+from sarcover.formulations.bp.highs import INF, packing_milp, quiet_highs, solve_lp
 from sarcover.formulations.bp.master import spread, violated_triples
 
 
@@ -199,9 +199,7 @@ class EnumeratedLP:
         while True:
             if time.perf_counter() > deadline:
                 return None
-            self.h.run()
-            if self.h.getModelStatus() != highspy.HighsModelStatus.kOptimal:
-                raise RuntimeError(f"enumerated LP status {self.h.getModelStatus()}")
+            solve_lp(self.h, "enumerated LP")
             sol = self.h.getSolution()
             y = np.asarray(sol.row_dual).copy()
             y[np.isinf(self.lo) & (y < 0)] = 0.0  # "<=" rows: y >= 0

@@ -21,6 +21,42 @@ def quiet_highs() -> highspy.Highs:
     return h
 
 
+class LPFailure(RuntimeError):
+    """HiGHS ended an LP with a status other than optimal, even after :func:`solve_lp`'s
+    retries. The branch-and-price stops its search on it and reports its plan and the bound
+    it has certified so far."""
+
+
+# Re-runs after a non-optimal LP status: HiGHS's simplex can end a degenerate LP (the route
+# master is one) with status "unknown" when its anti-cycling stops it; run again, or with another
+# random seed, or from no basis, it solves the same LP (HiGHS issues 1528, 2108).
+RETRY_SEEDS = (None, 1, 2)
+
+
+def solve_lp(h: highspy.Highs, what: str) -> None:
+    """Run ``h`` (an LP) to optimality: on another status run it again (the same seed, then
+    other random seeds, the last time from no basis); raise :class:`LPFailure` naming ``what``
+    if none is optimal. The random seed is left as it was."""
+    h.run()
+    status = h.getModelStatus()
+    if status == highspy.HighsModelStatus.kOptimal:
+        return
+    seed = h.getOptionValue("random_seed")
+    seed = seed[1] if isinstance(seed, tuple) else seed  # highspy returns (status, value)
+    try:
+        for i, retry_seed in enumerate(RETRY_SEEDS):
+            if retry_seed is not None:
+                h.setOptionValue("random_seed", seed + retry_seed)
+            if i == len(RETRY_SEEDS) - 1:
+                h.clearSolver()  # from no basis
+            h.run()
+            if h.getModelStatus() == highspy.HighsModelStatus.kOptimal:
+                return
+    finally:
+        h.setOptionValue("random_seed", seed)
+    raise LPFailure(f"{what}: HiGHS status {h.getModelStatus()} (first {status}) after {len(RETRY_SEEDS)} retries")
+
+
 def packing_milp(lo, hi, prize, ub, starts, index, value, time_limit: float, *,
                  first: np.ndarray | None = None, abs_gap: bool = False) -> highspy.Highs:
     """HiGHS run on a set-packing MILP over routes: binary columns (``prize``, upper bounds

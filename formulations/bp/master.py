@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import highspy
 import numpy as np
-from sarcover.formulations.bp.highs import INF, packing_milp, quiet_highs
+from sarcover.formulations.bp.highs import INF, packing_milp, quiet_highs, solve_lp
 
 MAX_CUTS = 64
 
@@ -392,10 +392,7 @@ class Master:
     # -- solving ---------------------------------------------------------------------------
     def solve(self):
         """Solve the restricted LP. Returns (value, x_routes, x_art, y) with clipped duals."""
-        self.h.run()
-        st = self.h.getModelStatus()
-        if st != highspy.HighsModelStatus.kOptimal:
-            raise RuntimeError(f"master LP status {st}")
+        solve_lp(self.h, "master LP")
         sol = self.h.getSolution()
         x = np.asarray(sol.col_value)
         y = np.asarray(sol.row_dual).copy()

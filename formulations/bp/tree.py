@@ -14,6 +14,7 @@ a run whose open nodes all floor to the incumbent is proven.
 from __future__ import annotations
 
 import heapq
+import logging
 import math
 import time
 
@@ -25,6 +26,7 @@ from sarcover.formulations.bp.cuts import CutRounds
 from sarcover.formulations.bp.elimination import Elimination
 from sarcover.formulations.bp.enumeration import Enumeration
 from sarcover.formulations.bp.graph import NodeState
+from sarcover.formulations.bp.highs import LPFailure
 from sarcover.formulations.bp.incumbent import IncumbentSearch
 from sarcover.formulations.bp.options import BPOptions
 from sarcover.formulations.bp.pricer import Pricer
@@ -32,6 +34,8 @@ from sarcover.formulations.bp.root import Root
 from sarcover.formulations.bp.search import Search
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.plan import Plan
+
+log = logging.getLogger(__name__)
 
 
 class BranchAndPrice:
@@ -46,6 +50,7 @@ class BranchAndPrice:
         opts = (BPOptions.for_time_limit(time_limit) if options is None
                 else options.with_limit_defaults(time_limit))
         self.options = opts
+        self.stopped = None  # why the search stopped before its time was up (an LP HiGHS failed on)
         s = self.search = Search(instance, time_limit, opts)
 
         def share(f: float) -> float:  # seconds for a root dive, the labelling arc bounds
@@ -99,63 +104,70 @@ class BranchAndPrice:
         unresolved = []  # nodes not split (nothing fractional in an unconverged LP) and their bounds
         last_milp_cols = 0
         proven = False
-        while heap:
-            if s.clock.time_left() <= 0:
-                break
-            if s.stats.nodes and self.enumeration is not None and self.enumeration.close():
-                return self._close([], [], True)  # every better plan was among its routes
-            _, _, negb, _, state = heapq.heappop(heap)
-            parent_bound = -negb
-            if s.prunable(parent_bound):
-                continue
-            s.stats.nodes += 1
-            if state.depth == 0:
-                bound, x, xa, converged = self.root.solve(state, parent_bound)
-                if s.clock.time_left() > 0:
-                    inc.run_milp(min(10.0, 0.25 * s.clock.time_left()))
-                    last_milp_cols = m.n_routes
-            else:
-                bound, x, xa, converged = self.colgen.solve(state, parent_bound)
-            if not converged and s.clock.time_left() <= 0:
-                heapq.heappush(heap, self._node_key(bound, state.depth, counter, state))
-                counter += 1
-                break
-            # not converged with time left: an exact pricing hit its label cap. The node's
-            # bound (its parent's, or one certified before the cap) still holds, so it is
-            # branched on its current LP: the children's pricing graphs are smaller
-            if s.prunable(bound):
-                continue
-            if s.stats.nodes % opts.dive_every == 0 and s.clock.time_left() > 0:
-                # dive again from this node (other fixings than the root's dive)
-                inc.dive(min(0.3 * inc.dive_limit, 0.25 * s.clock.time_left()), start=state)
-                m.apply(state)
-                _, x, xa, _ = m.solve()
+        state, parent_bound = root, trivial
+        try:
+            while heap:
+                if s.clock.time_left() <= 0:
+                    break
+                if s.stats.nodes and self.enumeration is not None and self.enumeration.close():
+                    return self._close([], [], True)  # every better plan was among its routes
+                _, _, negb, _, state = heapq.heappop(heap)
+                parent_bound = -negb
+                if s.prunable(parent_bound):
+                    continue
+                s.stats.nodes += 1
+                if state.depth == 0:
+                    bound, x, xa, converged = self.root.solve(state, parent_bound)
+                    if s.clock.time_left() > 0:
+                        inc.run_milp(min(10.0, 0.25 * s.clock.time_left()))
+                        last_milp_cols = m.n_routes
+                else:
+                    bound, x, xa, converged = self.colgen.solve(state, parent_bound)
+                if not converged and s.clock.time_left() <= 0:
+                    heapq.heappush(heap, self._node_key(bound, state.depth, counter, state))
+                    counter += 1
+                    break
+                # not converged with time left: an exact pricing hit its label cap. The node's
+                # bound (its parent's, or one certified before the cap) still holds, so it is
+                # branched on its current LP: the children's pricing graphs are smaller
                 if s.prunable(bound):
                     continue
-            if inc.offer_if_integral(x, xa):
-                if converged:
-                    continue  # the node's LP optimum is a plan: the node is solved
-                # not converged (a label cap): the LP optimum over all routes is unknown, so an
-                # integral LP solution closes nothing (at 600 points the degenerate LP sits at
-                # the incumbent's routes); with nothing fractional to branch on, its bound stays
-                unresolved.append(bound)
-                s.stats.open_integral += 1
-                continue
-            lp_value = float(np.dot(m.route_prize, x[: m.n_routes]))
-            children = branch(s, state, x, lp_value, opts.strong, opts.group_branching)
-            if children is None:
-                unresolved.append(bound)
-                s.stats.open_integral += 1
-                continue
-            s.stats.group_branches += children[0].group_bounds != state.group_bounds
-            for ch in children:
-                heapq.heappush(heap, self._node_key(bound, ch.depth, counter, ch))
-                counter += 1
-            if s.stats.nodes % opts.milp_every == 0 and m.n_routes > last_milp_cols:
-                inc.run_milp(min(5.0, 0.1 * max(s.clock.time_left(), 0.0)))
-                last_milp_cols = m.n_routes
-        else:
-            proven = not unresolved
+                if s.stats.nodes % opts.dive_every == 0 and s.clock.time_left() > 0:
+                    # dive again from this node (other fixings than the root's dive)
+                    inc.dive(min(0.3 * inc.dive_limit, 0.25 * s.clock.time_left()), start=state)
+                    m.apply(state)
+                    _, x, xa, _ = m.solve()
+                    if s.prunable(bound):
+                        continue
+                if inc.offer_if_integral(x, xa):
+                    if converged:
+                        continue  # the node's LP optimum is a plan: the node is solved
+                    # not converged (a label cap): the LP optimum over all routes is unknown, so an
+                    # integral LP solution closes nothing (at 600 points the degenerate LP sits at
+                    # the incumbent's routes); with nothing fractional to branch on, its bound stays
+                    unresolved.append(bound)
+                    s.stats.open_integral += 1
+                    continue
+                lp_value = float(np.dot(m.route_prize, x[: m.n_routes]))
+                children = branch(s, state, x, lp_value, opts.strong, opts.group_branching)
+                if children is None:
+                    unresolved.append(bound)
+                    continue
+                s.stats.group_branches += children[0].group_bounds != state.group_bounds
+                for ch in children:
+                    heapq.heappush(heap, self._node_key(bound, ch.depth, counter, ch))
+                    counter += 1
+                if s.stats.nodes % opts.milp_every == 0 and m.n_routes > last_milp_cols:
+                    inc.run_milp(min(5.0, 0.1 * max(s.clock.time_left(), 0.0)))
+                    last_milp_cols = m.n_routes
+            else:
+                proven = not unresolved
+        except LPFailure as exc:
+            # HiGHS could not solve an LP even after retries: stop the search. The node being
+            # solved keeps its parent's bound, so the reported bound stays a certified one
+            self.stopped = str(exc)
+            log.warning("bp stopped early: %s", exc)
+            heapq.heappush(heap, self._node_key(parent_bound, state.depth, counter, state))
         if not proven and m.n_routes:
             # the time kept in reserve: a last MILP over everything generated
             inc.run_milp(max(0.0, s.clock.hard_deadline - time.perf_counter() - 0.1))
