@@ -50,7 +50,7 @@ class BranchAndPrice:
         opts = (BPOptions.for_time_limit(time_limit) if options is None
                 else options.with_limit_defaults(time_limit))
         self.options = opts
-        self.stopped = None  # why the search stopped before its time was up (an LP HiGHS failed on)
+        self.stopped = None  # why the search stopped before its time was up (an LP, memory)
         s = self.search = Search(instance, time_limit, opts)
 
         def share(f: float) -> float:  # seconds for a root dive, the labelling arc bounds
@@ -162,11 +162,12 @@ class BranchAndPrice:
                     last_milp_cols = m.n_routes
             else:
                 proven = not unresolved
-        except LPFailure as exc:
-            # HiGHS could not solve an LP even after retries: stop the search. The node being
-            # solved keeps its parent's bound, so the reported bound stays a certified one
-            self.stopped = str(exc)
-            log.warning("bp stopped early: %s", exc)
+        except (LPFailure, MemoryError) as exc:
+            # HiGHS could not solve an LP even after retries, or an allocation failed (a pricing's
+            # labels at hundreds of points under a worker's memory limit): stop the search. The
+            # node being solved keeps its parent's bound, so the reported bound stays certified
+            self.stopped = str(exc) if isinstance(exc, LPFailure) else f"out of memory ({exc})"
+            log.warning("bp stopped early: %s", self.stopped)
             heapq.heappush(heap, self._node_key(parent_bound, state.depth, counter, state))
         if not proven and m.n_routes:
             # the time kept in reserve: a last MILP over everything generated

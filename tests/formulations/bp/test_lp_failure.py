@@ -84,3 +84,27 @@ def test_bp_stops_on_an_lp_failure_with_its_plan_and_a_valid_bound(monkeypatch):
     assert r.status == Status.FEASIBLE and "stopped early" in r.reason and "kUnknown" in r.reason
     assert r.plan is not None and verify(inst, r.plan).valid
     assert r.bound is not None and r.bound >= OPTIMAL["p2.2.k"] - 1e-6 >= verify(inst, r.plan).prize - 1e-6
+
+
+def test_bp_stops_when_memory_runs_out_with_its_plan_and_a_valid_bound(monkeypatch):
+    """An allocation that fails in the pricing (the scale run: M = 100, K = 3 under a worker's
+    4 GB) ends the search like a failed LP: status feasible with the reason, a verified plan,
+    a bound no lower than the optimum; never an error."""
+    from sarcover.formulations.bp import pricer
+
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    calls = [0]
+    real = pricer.Pricer.price
+
+    def failing(self, *args, **kw):
+        calls[0] += 1
+        if calls[0] > 10:
+            raise MemoryError("Allocation failed (probably too large).")
+        return real(self, *args, **kw)
+
+    monkeypatch.setattr(pricer.Pricer, "price", failing)
+    r = solve_bp(inst, time_limit=20)
+    assert calls[0] > 10
+    assert r.status == Status.FEASIBLE and "out of memory" in r.reason
+    assert r.plan is not None and verify(inst, r.plan).valid
+    assert r.bound is not None and r.bound >= OPTIMAL["p2.2.k"] - 1e-6 >= verify(inst, r.plan).prize - 1e-6
