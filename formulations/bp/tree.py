@@ -162,6 +162,10 @@ class BranchAndPrice:
                     last_milp_cols = m.n_routes
             else:
                 proven = not unresolved
+                if unresolved and s.clock.time_left() > 0:
+                    # nothing left to branch on before the limit: say so, not "time limit"
+                    self.stopped = (f"{len(unresolved)} node(s) left open with nothing to branch on "
+                                    "(an exact pricing at its label cap, an integral LP)")
         except (LPFailure, MemoryError) as exc:
             # HiGHS could not solve an LP even after retries, or an allocation failed (a pricing's
             # labels at hundreds of points under a worker's memory limit): stop the search. The

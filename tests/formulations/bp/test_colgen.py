@@ -114,3 +114,4 @@ def test_unconverged_node_with_an_integral_lp_solution_stays_open():
     assert not proven
     assert bound >= OPTIMAL["p2.2.k"] - 1e-6
     assert bp.search.stats.open_integral == 1  # counted: a row says when this happened
+    assert "label cap" in bp.stopped  # the run says why it ended before its limit
