@@ -29,13 +29,13 @@ top-4-7           2.6 h     bp alone at 600 s on the 192 shipped files of TOP se
 paper-validation  2.3 h     bp alone on the paper grid with paper-opt's limits, 20 held-out instances per
                             setting (seeds 200..219, which chose no setting): its proof rates beside
                             paper-opt's, which are tuning figures (about paper-opt's bp part)
-scale             ~4 h      M=20..100 at K=3 and 6 (60-600 viewpoints), 10 instances each: every method
-                            against bp (60 s at K=3, 600 s at K=6; milp and cpsat only at M<=40);
-                            bp's 40 K=6 jobs at 600 s dominate; four instances per setting took 93
-                            min on 2 Dask workers, without three of bp's jobs (docs/scale.md)
+scale             ~7 h      M=20..100 at K=3 and 6 (60-600 viewpoints), 10 instances each: every method
+                            against bp (600 s; milp and cpsat only at M<=40); bp's 70 jobs that use
+                            their 600 s dominate (about 4 100 s of bp and 620 s of the other methods
+                            per instance seed, measured on seed 306: docs/scale.md)
 ================  ========  =========================================================================
 
-In all about 12 h on 2 cores (``--skip scale --skip paper-validation``: about 6 h).
+In all about 15 h on 2 cores (``--skip scale --skip paper-validation``: about 6 h).
 ``--runs R`` sets the random instances per setting of paper-n and paper-k (the paper: 1000, the
 default); ``--skip STEP`` leaves a suite or the decomposition out; ``--report-only`` only rewrites
 the report. Every step resumes: a stopped run continues where it stopped. The results directory
