@@ -103,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     """Run the steps, then write the report. Ctrl-C or SIGTERM stops it with exit code 130 and
     loses nothing (every step resumes); a stored run that does not fit the suite (a changed
     setting) is a one-line error with exit code 2."""
-    from sarcover.benchmarks.cli import EXIT_BAD_INPUT, EXIT_INTERRUPTED, sigterm_as_interrupt
+    from sarcover.benchmarks.cli import EXIT_BAD_INPUT, EXIT_INTERRUPTED, _one_line, sigterm_as_interrupt
     from sarcover.formulations.errors import SarcoverError
 
     prog = "python -m sarcover.benchmarks.reproduce"
@@ -111,7 +111,7 @@ def main(argv: list[str] | None = None) -> int:
         try:
             return _main(argv, prog)
         except SarcoverError as exc:
-            print(f"{prog}: error: {' '.join(str(exc).splitlines())}", file=sys.stderr)
+            print(f"{prog}: error: {_one_line(exc)}", file=sys.stderr)
             return EXIT_BAD_INPUT
         except KeyboardInterrupt:
             print(f"{prog}: interrupted; the rows so far are kept, the same command resumes",

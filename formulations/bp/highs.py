@@ -27,10 +27,11 @@ class LPFailure(RuntimeError):
     it has certified so far."""
 
 
-# Re-runs after a non-optimal LP status: HiGHS's simplex can end a degenerate LP (the route
-# master is one) with status "unknown" when its anti-cycling stops it; run again, or with another
-# random seed, or from no basis, it solves the same LP (HiGHS issues 1528, 2108).
-RETRY_SEEDS = (None, 1, 2)
+# Re-runs after a non-optimal LP status, as (random seed offset, from no basis): HiGHS's simplex
+# can end a degenerate LP (the route master is one) with status "unknown" when its anti-cycling
+# stops it; run again, or with another random seed, or from no basis, it solves the same LP
+# (HiGHS issues 1528, 2108).
+RETRIES = ((0, False), (1, False), (2, True))
 
 
 def solve_lp(h: highspy.Highs, what: str) -> None:
@@ -44,17 +45,16 @@ def solve_lp(h: highspy.Highs, what: str) -> None:
     seed = h.getOptionValue("random_seed")
     seed = seed[1] if isinstance(seed, tuple) else seed  # highspy returns (status, value)
     try:
-        for i, retry_seed in enumerate(RETRY_SEEDS):
-            if retry_seed is not None:
-                h.setOptionValue("random_seed", seed + retry_seed)
-            if i == len(RETRY_SEEDS) - 1:
-                h.clearSolver()  # from no basis
+        for offset, cold in RETRIES:
+            h.setOptionValue("random_seed", seed + offset)
+            if cold:
+                h.clearSolver()
             h.run()
             if h.getModelStatus() == highspy.HighsModelStatus.kOptimal:
                 return
     finally:
         h.setOptionValue("random_seed", seed)
-    raise LPFailure(f"{what}: HiGHS status {h.getModelStatus()} (first {status}) after {len(RETRY_SEEDS)} retries")
+    raise LPFailure(f"{what}: HiGHS status {h.getModelStatus()} (first {status}) after {len(RETRIES)} retries")
 
 
 def packing_milp(lo, hi, prize, ub, starts, index, value, time_limit: float, *,

@@ -8,7 +8,7 @@ import highspy
 import pytest
 
 from sarcover.formulations.bp import solve_bp
-from sarcover.formulations.bp.highs import RETRY_SEEDS, LPFailure, solve_lp
+from sarcover.formulations.bp.highs import RETRIES, LPFailure, solve_lp
 from sarcover.formulations.io import load_instance
 from sarcover.formulations.result import Status
 from sarcover.formulations.verify import verify
@@ -44,7 +44,7 @@ class Flaky:
         self.cleared += 1
 
 
-@pytest.mark.parametrize("failures", [1, 2, len(RETRY_SEEDS)])
+@pytest.mark.parametrize("failures", [1, 2, len(RETRIES)])
 def test_an_lp_ending_unknown_is_run_again(failures):
     """Again with the same seed, then with other seeds, the last time from no basis; the seed
     is left as it was."""
@@ -52,7 +52,7 @@ def test_an_lp_ending_unknown_is_run_again(failures):
     solve_lp(h, "master LP")
     assert h.runs == failures + 1
     assert h.seeds[:2] == [7, 7] and len(set(h.seeds)) == min(failures, 2) + (failures == 3)
-    assert h.cleared == (failures == len(RETRY_SEEDS))
+    assert h.cleared == (failures == len(RETRIES))
     assert h.seed == 7
 
 
@@ -60,7 +60,7 @@ def test_an_lp_that_never_solves_raises_lp_failure_naming_it():
     h = Flaky(failures=100)
     with pytest.raises(LPFailure, match="master LP: HiGHS status .*Unknown"):
         solve_lp(h, "master LP")
-    assert h.runs == 1 + len(RETRY_SEEDS) and h.seed == 7
+    assert h.runs == 1 + len(RETRIES) and h.seed == 7
 
 
 def test_bp_stops_on_an_lp_failure_with_its_plan_and_a_valid_bound(monkeypatch):
