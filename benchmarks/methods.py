@@ -30,13 +30,13 @@ from typing import Callable, Literal
 from sarcover.benchmarks.params import param, takes
 from sarcover.formulations.history import shifted
 from sarcover.formulations.instance import TOPInstance
-from sarcover.formulations.result import Result
+from sarcover.formulations.result import Result, Termination
 
 DEFAULT_TIME_LIMIT = 60.0  # seconds per run when the caller gives none (solve, run_method, CLI, suites)
 
 
 # -- composition shared by the exact methods -------------------------------------------------------
-def warm_started(solve: Callable[..., Result], instance: TOPInstance, *, seed: int,
+def warm_started(solve: Callable[..., Result], instance: TOPInstance, *, method: str, seed: int,
                  time_limit: float | None, **options) -> Result:
     """``solve`` started from greedy's plan (when greedy finds one), within the same time limit.
 
@@ -44,6 +44,11 @@ def warm_started(solve: Callable[..., Result], instance: TOPInstance, *, seed: i
     hint, bp's first columns and incumbent), so a run the limit stops still returns a plan that
     covers every group whenever greedy found one. The solver gets what greedy left of the limit;
     the returned runtime and the anytime history count from this call, greedy included.
+
+    A model too large for the process's memory (a ``MemoryError``: the harness limits each
+    worker's memory, and the MILP and CP-SAT models of 240 points pass 4 GB) ends the run with
+    greedy's plan, no bound and the reason, as a run the limit stops would end, instead of an
+    error: ``method`` names the method in that result.
     """
     from sarcover.heuristics.greedy import greedy
 
@@ -51,7 +56,12 @@ def warm_started(solve: Callable[..., Result], instance: TOPInstance, *, seed: i
     plan = greedy(instance, seed=seed).plan
     spent = time.perf_counter() - t0
     left = None if time_limit is None else max(time_limit - spent, 0.01)
-    result = solve(instance, seed=seed, time_limit=left, warm_start=plan, **options)
+    try:
+        result = solve(instance, seed=seed, time_limit=left, warm_start=plan, **options)
+    except MemoryError as exc:
+        why = str(exc) or "MemoryError"
+        result = Result(method, Termination.COMPLETED, plan=plan,
+                        reason=f"out of memory ({why}); greedy's plan, the warm start")
     result.runtime_s = time.perf_counter() - t0
     if "history" in result.info:
         result.info["history"] = shifted(result.info["history"], spent)
@@ -264,7 +274,8 @@ def milp(instance, *, seed=0, time_limit=DEFAULT_TIME_LIMIT, **params) -> Result
     """Time-flow TOP MILP on HiGHS via Pyomo, from greedy's plan."""
     from sarcover.formulations.milp import solve_milp
 
-    return warm_started(solve_milp, instance, seed=seed, time_limit=time_limit, **asdict(MILPParams(**params)))
+    return warm_started(solve_milp, instance, method="milp", seed=seed, time_limit=time_limit,
+                        **asdict(MILPParams(**params)))
 
 
 @dataclass(frozen=True)
@@ -281,7 +292,8 @@ def cpsat(instance, *, seed=0, time_limit=DEFAULT_TIME_LIMIT, **params) -> Resul
     """CP-SAT routes constraint + energy flow, from greedy's plan as hint."""
     from sarcover.formulations.cpsat import solve_cpsat
 
-    return warm_started(solve_cpsat, instance, seed=seed, time_limit=time_limit, **asdict(CPSATParams(**params)))
+    return warm_started(solve_cpsat, instance, method="cpsat", seed=seed, time_limit=time_limit,
+                        **asdict(CPSATParams(**params)))
 
 
 @takes("sarcover.formulations.bp.options:BPOptions")  # named, so that listing does not import bp
@@ -296,7 +308,7 @@ def bp(instance, *, seed=0, time_limit=DEFAULT_TIME_LIMIT, **params) -> Result:
     from sarcover.heuristics.pyvrp_ils import primal_routes
 
     options = BPOptions(**params).with_limit_defaults(time_limit)
-    return warm_started(solve_bp, instance, seed=seed, time_limit=time_limit, options=options,
+    return warm_started(solve_bp, instance, method="bp", seed=seed, time_limit=time_limit, options=options,
                         primal=primal_routes(instance, seed))
 
 

@@ -148,6 +148,28 @@ def test_run_method_prechecks_once_and_the_solver_is_not_called(monkeypatch):
     assert res.status == Status.INFEASIBLE and "cannot be covered" in res.reason and calls == []
 
 
+@pytest.mark.parametrize("name, module, front_door", [
+    ("milp", "sarcover.formulations.milp", "solve_milp"),
+    ("cpsat", "sarcover.formulations.cpsat", "solve_cpsat"),
+    ("bp", "sarcover.formulations.bp", "solve_bp"),
+])
+def test_a_model_too_large_for_memory_ends_with_greedys_plan_and_says_why(monkeypatch, name, module, front_door):
+    """A MemoryError in an exact method's model (the MILP and CP-SAT models of 240 points pass a
+    worker's 4 GB) is not an error row: the run returns the warm start, verified, with the reason."""
+    import importlib
+
+    def too_large(*args, **kwargs):
+        raise MemoryError("Unable to allocate 34.1 MiB for an array")
+
+    monkeypatch.setattr(importlib.import_module(module), front_door, too_large)
+    inst = sarcover.generate(targets=6, views=2, uavs=2, seed=3)
+    res = sarcover.solve(inst, name, time_limit=5)
+    greedy = sarcover.solve(inst, "greedy")
+    assert res.status == Status.FEASIBLE and res.termination is Termination.COMPLETED
+    assert res.valid and res.objective == greedy.objective and res.bound is None
+    assert "out of memory (Unable to allocate 34.1 MiB" in res.reason
+
+
 def test_ad_hoc_methods_do_not_join_the_registry(tmp_path):
     """A suite's ``module:function`` method runs, but never shows up in the shared registry."""
     from sarcover.benchmarks.registry import METHODS, get_method, run_method
