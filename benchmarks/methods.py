@@ -45,10 +45,10 @@ def warm_started(solve: Callable[..., Result], instance: TOPInstance, *, method:
     covers every group whenever greedy found one. The solver gets what greedy left of the limit;
     the returned runtime and the anytime history count from this call, greedy included.
 
-    A model too large for the process's memory (a ``MemoryError``: the harness limits each
-    worker's memory, and the MILP and CP-SAT models of 240 points pass 4 GB) ends the run with
-    greedy's plan, no bound and the reason, as a run the limit stops would end, instead of an
-    error: ``method`` names the method in that result.
+    A model or search too large for the process's memory (a ``MemoryError``: the harness limits
+    each worker's memory, and CP-SAT's and the MILP's searches on 240 points have passed 4 GB)
+    ends the run with greedy's plan, no bound and the reason, as a run the limit stops would end,
+    instead of an error: ``method`` names the method in that result.
     """
     from sarcover.heuristics.greedy import greedy
 

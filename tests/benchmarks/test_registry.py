@@ -154,8 +154,9 @@ def test_run_method_prechecks_once_and_the_solver_is_not_called(monkeypatch):
     ("bp", "sarcover.formulations.bp", "solve_bp"),
 ])
 def test_a_model_too_large_for_memory_ends_with_greedys_plan_and_says_why(monkeypatch, name, module, front_door):
-    """A MemoryError in an exact method's model (the MILP and CP-SAT models of 240 points pass a
-    worker's 4 GB) is not an error row: the run returns the warm start, verified, with the reason."""
+    """A MemoryError in an exact method's model or search (CP-SAT and the MILP have passed a
+    worker's 4 GB at 240 points) is not an error row: the run returns the warm start, verified, with
+    the reason."""
     import importlib
 
     def too_large(*args, **kwargs):
