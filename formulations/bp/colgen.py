@@ -104,7 +104,7 @@ class ColumnGeneration:
                 # With the triangle inequality a node of reduced prize <= 0 can be skipped.
                 allowed &= prof > 1e-12
             y0 = float(y[0])
-            res = pricer.price(cost, ret, prof, allowed, heuristic=True, y0=y0, sig=sig)
+            res = pricer.heuristic(cost, ret, prof, allowed, y0=y0, sig=sig)
             bound = self._relaxed_bound(y, res, bound, root is not None)
             if s.prunable(bound):
                 return bound, x, xa, True  # the relaxed bound proves (or prunes) already

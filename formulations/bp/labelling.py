@@ -359,11 +359,13 @@ class PricingResult:
     improving elementary routes found (solver indices, without start and end). ``relaxed``: an
     upper bound on the best elementary path's reduced prize that holds whether or not the search
     finished (the suffix tables' best walk from the start, :func:`.bounds.suffix_dp`, cut duals
-    left unpaid); +inf when the tables are off."""
+    left unpaid); +inf when the tables are off. ``stopped``: the search stopped before it was
+    done (its label cap or its deadline), in either mode."""
 
-    __slots__ = ("best", "exact", "routes", "cycles", "n_labels", "ng_routes", "relaxed")
+    __slots__ = ("best", "exact", "routes", "cycles", "n_labels", "ng_routes", "relaxed", "stopped")
 
-    def __init__(self, best, exact, routes, cycles, n_labels, ng_routes=(), relaxed=np.inf):
+    def __init__(self, best, exact, routes, cycles, n_labels, ng_routes=(), relaxed=np.inf,
+                 stopped=False):
         self.best = best
         self.exact = exact
         self.routes = routes
@@ -371,6 +373,7 @@ class PricingResult:
         self.n_labels = n_labels
         self.ng_routes = ng_routes
         self.relaxed = relaxed
+        self.stopped = stopped
 
 
 def label_table(cost, profit, budget, ng, allowed, threshold, max_labels, deadline, delta, nb,
@@ -515,5 +518,5 @@ def price(cost, ret, profit, budget, ng, allowed, *, heuristic, max_labels, n_co
                         cycles.append(tuple(path[last[u] : pos + 1]))
                     last[u] = pos
     return PricingResult(best, (not hit) and (not heuristic), routes, cycles, total, ng_routes,
-                         relaxed_best(*tables, budget))
+                         relaxed_best(*tables, budget), bool(hit))
 

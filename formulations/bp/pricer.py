@@ -16,12 +16,18 @@ if TYPE_CHECKING:
     from sarcover.formulations.bp.search import Search
 
 
+HEURISTIC_LABELS = 200_000  # labels a heuristic call may make at first (see Pricer.heuristic)
+ROOT_LABEL_GROWTH = 4  # at the root the exact calls' label cap may grow to this multiple
+
+
 class Pricer:
     """Pricing calls of one run. ``bidirectional``: the exact pricing direction; None until the
     first exact call has measured both. ``keep``: the exact calls' share of near-best routes
     (:func:`.labelling.price`); ``exact_labels``: their label cap. From ``sparse_from`` points
     on, the heuristic calls run on the ``sparse_arcs`` cheapest arcs out of each point
-    (:func:`.graph.sparse_graph`; 0: never) and return up to ``heuristic_columns`` routes."""
+    (:func:`.graph.sparse_graph`; 0: never) and return up to ``heuristic_columns`` routes.
+    ``heuristic_labels``: the heuristic calls' label cap, which grows when a capped call finds
+    nothing (:meth:`heuristic`)."""
 
     def __init__(self, search: "Search", bidirectional: bool | None, ng_columns: bool,
                  keep: float, exact_labels: int, *, sparse_arcs: int = 0, sparse_from: int = 0,
@@ -34,6 +40,8 @@ class Pricer:
         self.ng_columns = ng_columns
         self.keep = keep
         self.exact_labels = exact_labels
+        self.max_exact_labels = ROOT_LABEL_GROWTH * exact_labels  # see raise_exact_cap
+        self.heuristic_labels = HEURISTIC_LABELS
         self.last_exact_labels = None  # sizes the next exact call's dominance layout
 
     def price(self, cost, ret, prof, allowed, *, heuristic: bool, y0: float, sig,
@@ -51,7 +59,7 @@ class Pricer:
             cost = sparse_graph(cost, allowed, self.sparse_arcs)
             ret = cheapest_return(cost)
         res = price(cost, ret, prof, s.problem.budget, s.ng, allowed, heuristic=heuristic,
-                    max_labels=200_000 if heuristic else self.exact_labels,
+                    max_labels=self.heuristic_labels if heuristic else self.exact_labels,
                     n_cols=self.heuristic_columns if heuristic else 60, min_gain=y0 + TOL,
                     deadline=s.clock.deadline if deadline is None else deadline,
                     bidirectional=bool(self.bidirectional) and not heuristic,
@@ -65,6 +73,31 @@ class Pricer:
             self.last_exact_labels = res.n_labels
         s.stats.labels += res.n_labels
         return res
+
+    def heuristic(self, cost, ret, prof, allowed, *, y0: float, sig):
+        """Heuristic pricing (:meth:`price`). A call that stops at its label cap without an
+        improving route runs again with four times the cap, while it is below the exact calls' cap: labels
+        are extended in order of energy, so a capped call has not reached the long routes, and
+        ending the heuristic phase there hands its work to exact calls that take tens of times
+        longer (at 360-600 points, docs/bp-log.md "the heuristic label cap")."""
+        while True:
+            res = self.price(cost, ret, prof, allowed, heuristic=True, y0=y0, sig=sig)
+            if (self.columns(res) or not res.stopped or self.search.clock.time_left() <= 0
+                    or self.heuristic_labels >= self.exact_labels):
+                return res
+            self.heuristic_labels = min(4 * self.heuristic_labels, self.exact_labels)
+            self.search.stats.heuristic_labels = self.heuristic_labels
+
+    def raise_exact_cap(self) -> bool:
+        """Double the exact calls' label cap, up to ``ROOT_LABEL_GROWTH`` times the option's
+        (memory: about 100 bytes a label); whether it grew. The root calls it when an exact
+        pricing hit the cap and no cut round is left to withdraw, so that its column generation
+        goes on instead of branching on an unconverged LP."""
+        if self.exact_labels >= self.max_exact_labels:
+            return False
+        self.exact_labels = min(2 * self.exact_labels, self.max_exact_labels)
+        self.search.stats.exact_label_cap = self.exact_labels
+        return True
 
     def exact(self, cost, ret, prof, allowed, y0: float, sig):
         """Exact pricing. On the first call both searches run, the bidirectional one under the

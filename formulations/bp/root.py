@@ -54,8 +54,12 @@ class Root:
         self.search.log(bound)
 
     def label_cap(self) -> bool:
-        """Withdraw the last cut round (an exact pricing under its cuts hit the label cap)."""
-        return self.cuts.withdraw()
+        """An exact pricing hit the label cap: withdraw the last cut round (its cuts make the
+        labels dominate less), or with none left, let the exact calls make twice as many labels
+        (:meth:`.pricer.Pricer.raise_exact_cap`): branching on an unconverged root splits off
+        children whose pricing is as large, and with an integral LP leaves nothing to branch on
+        (the run would end before its limit). Whether column generation goes on."""
+        return self.cuts.withdraw() or self.colgen.pricer.raise_exact_cap()
 
     def settled(self, state: NodeState, bound: float) -> bool:
         """The root's floored bound is settled: find a plan before growing ng sets (which only

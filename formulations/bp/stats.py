@@ -33,6 +33,8 @@ class Stats:
     cuts_purged: int = 0
     cuts_withdrawn: int = 0  # removed because an exact pricing under them hit its label cap
     label_caps: int = 0  # exact pricings that hit their label cap (no exact bound from them)
+    exact_label_cap: int | None = None  # the exact calls' cap, when the root raised it
+    heuristic_labels: int | None = None  # the heuristic calls' cap, when a capped call raised it
     relaxed_bounds: int = 0  # node bounds lowered by a relaxed pricing bound (no exact pricing)
     open_integral: int = 0  # unconverged nodes (label cap) with an integral LP: kept open, not solved
     arcs_eliminated: int = 0  # arcs no plan better than the incumbent can use
@@ -76,6 +78,7 @@ class Stats:
             "open_nodes": self.open_nodes,
             "cuts": self.cuts, "cuts_purged": self.cuts_purged,
             "cuts_withdrawn": self.cuts_withdrawn, "label_caps": self.label_caps,
+            "exact_label_cap": self.exact_label_cap, "heuristic_labels": self.heuristic_labels,
             "relaxed_bounds": self.relaxed_bounds, "open_integral": self.open_integral,
             "arcs_eliminated": self.arcs_eliminated, "elim_s": round(self.elim_s, 3),
             "elim_labels": self.elim_labels, "pool_routes": self.pool_routes,

@@ -72,6 +72,7 @@ def test_label_cap_that_brings_new_routes_leaves_the_lp_solution_readable():
 
     inst = load_instance(TOP_DIR / "p2.2.k.txt")
     bp = BranchAndPrice(inst, time_limit=20, options=BPOptions(cut_rounds=0))
+    bp.pricer.max_exact_labels = bp.pricer.exact_labels  # the root may not raise its cap here
     exact, capped = bp.pricer.exact, []
 
     def capped_with_new_routes(*args):
@@ -115,3 +116,75 @@ def test_unconverged_node_with_an_integral_lp_solution_stays_open():
     assert bound >= OPTIMAL["p2.2.k"] - 1e-6
     assert bp.search.stats.open_integral == 1  # counted: a row says when this happened
     assert "label cap" in bp.stopped  # the run says why it ended before its limit
+
+
+def test_label_capped_root_without_cuts_raises_the_cap_and_goes_on():
+    """An exact pricing at the root hits its label cap with no cut round to withdraw: the root
+    doubles the exact calls' cap and its column generation goes on, instead of branching on an
+    unconverged LP (at 600 points such a root with an integral LP ended the run at 265 s of
+    600). The cap is simulated on the first two exact calls; p2.2.k's published optimum is
+    proven at the root, the cap four times the option's."""
+    from sarcover.formulations.bp.labelling import PricingResult
+    from sarcover.formulations.bp.tree import BranchAndPrice
+
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    bp = BranchAndPrice(inst, time_limit=30, options=BPOptions(cut_rounds=0))
+    exact, capped = bp.pricer.exact, []
+    first_cap = bp.pricer.exact_labels
+
+    def capped_twice(*args):
+        res = exact(*args)
+        if len(capped) < 2:
+            capped.append(bp.pricer.exact_labels)
+            return PricingResult(res.best, False, res.routes, [], res.n_labels, res.ng_routes)
+        return res
+
+    bp.pricer.exact = capped_twice
+    proven, bound = bp.run()
+    stats = bp.search.stats
+    assert capped == [first_cap, 2 * first_cap] and stats.label_caps == 2
+    assert stats.exact_label_cap == bp.pricer.exact_labels == 4 * first_cap
+    assert stats.open_integral == 0 and bp.stopped is None
+    assert proven and bound == pytest.approx(OPTIMAL["p2.2.k"])
+
+
+def test_label_cap_grows_no_further_than_its_limit():
+    """The root raises the exact calls' cap at most to ROOT_LABEL_GROWTH times the option's;
+    after that a capped root is branched on as before."""
+    from sarcover.formulations.bp.pricer import ROOT_LABEL_GROWTH
+    from sarcover.formulations.bp.tree import BranchAndPrice
+
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    bp = BranchAndPrice(inst, time_limit=5, options=BPOptions(cut_rounds=0, exact_labels=1000))
+    grown = []
+    while bp.pricer.raise_exact_cap():
+        grown.append(bp.pricer.exact_labels)
+    assert grown and grown[-1] == ROOT_LABEL_GROWTH * 1000
+    assert grown == sorted(grown) and not bp.pricer.raise_exact_cap()
+
+
+def test_heuristic_pricing_capped_without_a_route_runs_again_with_a_larger_cap():
+    """A heuristic pricing call that stops at its label cap before it finds an improving route
+    runs again with four times the cap (labels go in order of energy: a capped call has not
+    reached the long routes). With a cap of 5 labels the run still proves p2.2.k's optimum,
+    the cap grown along the way."""
+    from sarcover.formulations.bp.tree import BranchAndPrice
+
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    bp = BranchAndPrice(inst, time_limit=30, options=BPOptions(cut_rounds=0))
+    bp.pricer.heuristic_labels = 5
+    seen, price = [], bp.pricer.price
+
+    def recording(*args, **kw):
+        res = price(*args, **kw)
+        if kw.get("heuristic"):
+            seen.append((bp.pricer.heuristic_labels, res.stopped, bool(bp.pricer.columns(res))))
+        return res
+
+    bp.pricer.price = recording
+    proven, bound = bp.run()
+    # some capped call found nothing and was run again at once with four times the cap
+    assert any(cap * 4 == seen[i + 1][0] and stopped and not found
+               for i, (cap, stopped, found) in enumerate(seen[:-1]))
+    assert bp.search.stats.heuristic_labels == bp.pricer.heuristic_labels > 5
+    assert proven and bound == pytest.approx(OPTIMAL["p2.2.k"])
