@@ -42,9 +42,12 @@ class Root:
     # -- the steps column generation takes at the root (:class:`.colgen.RootSteps`) -------------
     def slow_to_settle(self) -> bool:
         """The caller's heuristic, once, if the root's bound is not settled by
-        ``primal_late_share`` of the limit and no plan has been sought yet; whether it ran."""
+        ``primal_late_share`` of the limit and no plan has been sought since the start (at scale
+        the call before column generation does not count: for the registered bp it is PyVRP's
+        short search, the late one searches for its whole allowance); whether it ran."""
         s = self.search
-        return (not s.stats.primal_calls and not self.incumbents.dived
+        first = 1 if s.problem.V >= s.options.primal_first_from else 0
+        return (s.stats.primal_calls <= first and not self.incumbents.dived
                 and time.perf_counter() > s.clock.until(s.options.primal_late_share)
                 and self.incumbents.call_primal())
 

@@ -203,3 +203,25 @@ def test_at_scale_the_heuristic_runs_before_the_roots_column_generation():
                                               cut_rounds=0))
         bp.run()
         assert (seen[:1] == [0]) == before_any_round
+
+
+def test_at_scale_a_root_slow_to_settle_calls_the_heuristic_again():
+    """At scale the call before column generation does not stand in for the late one: a root
+    not settled by primal_late_share of the limit (here 0: at once) calls the heuristic again
+    before its first dive (the registered bp's first PyVRP search is a short one, the later
+    ones search their whole allowance); below primal_first_from only the late call runs
+    before the dive. Both prove p2.2.k."""
+    from sarcover.formulations.bp.tree import BranchAndPrice
+
+    inst = load_instance(TOP_DIR / "p2.2.k.txt")
+    for first_from, before_dive in [(0, 2), (10**6, 1)]:
+        seen = []
+        bp = BranchAndPrice(inst, time_limit=60,
+                            primal=lambda s: seen.append((bp.search.stats.rounds, bp.incumbents.dived)),
+                            options=BPOptions(primal_first_from=first_from, primal_late_share=0.0,
+                                              cut_rounds=0))
+        proven, bound = bp.run()
+        assert proven and bound == pytest.approx(OPTIMAL["p2.2.k"])
+        assert sum(1 for _, dived in seen if not dived) == before_dive
+        if first_from == 0:
+            assert seen[0][0] == 0 and seen[1][0] >= 1  # the scale call, then the late one
