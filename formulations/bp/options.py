@@ -120,7 +120,7 @@ class BPOptions:
     - ``primal_first_from``: from this many points on (beyond the paper's grid) the first call
       runs before the root's column generation: there the root takes most of the limit, the
       warm start (greedy) lies far below what PyVRP finds in seconds, and the LP starts from
-      the heuristic's routes.
+      the heuristic's routes. The late call (``primal_late_share``) still runs after it.
     - ``primal_share``, ``primal_cap_s``: time for each call of the caller's ``primal``
       heuristic, at most ``primal_cap_s`` seconds. 30 s: on
       M = 20, K = 5-6 a 30 s PyVRP search found plans one better than bp's (10 s) on about a
