@@ -22,7 +22,8 @@ Each round solves the restricted master LP and prices:
 At the root, column generation takes the root's own steps (:class:`RootSteps`, the policy in
 :mod:`.root`): the caller's heuristic when the root is slow to settle, the certificate of every
 exact bound, the first dive once the floored bound is settled (before the ng sets grow), the
-cut rounds last, and their withdrawal when an exact pricing under them hits its label cap.
+cut rounds last, and, when an exact pricing hits its label cap, their withdrawal or else a
+larger cap.
 """
 
 from __future__ import annotations
@@ -52,7 +53,8 @@ class RootSteps(Protocol):
         """An exact pricing certified ``lagrangian`` from duals ``y``; the root's ``bound``."""
 
     def label_cap(self) -> bool:
-        """An exact pricing hit its label cap: whether the LP changed so that it can go on."""
+        """An exact pricing hit its label cap: whether column generation can go on (cuts
+        withdrawn, or a larger cap)."""
 
     def settled(self, state: NodeState, bound: float) -> bool:
         """The floored bound is settled: whether plans were sought (the LP is then re-solved)."""
@@ -78,8 +80,8 @@ class ColumnGeneration:
     def solve(self, state: NodeState, bound: float):
         """Solve one node's LP by column generation, starting from the parent's ``bound``.
         Returns (bound, x, x_art, converged); not converged: out of time, or an exact pricing
-        hit its label cap (at the root first without the last cut round, see
-        :meth:`.cuts.CutRounds.withdraw`)."""
+        hit its label cap (at the root only once neither withdrawing the last cut round nor a
+        larger cap is left, see :meth:`.root.Root.label_cap`)."""
         s, m, pricer, elim = self.search, self.search.master, self.pricer, self.elimination
         root = self.root if state.depth == 0 else None
         version = None
@@ -123,8 +125,9 @@ class ColumnGeneration:
             if not res.exact:
                 bound = self._relaxed_bound(y, res, bound, root is not None)
             if not res.exact and s.clock.time_left() > 0:
-                # the label cap, not the clock: no bound from this call. Under the last cut
-                # round's cuts, withdraw them and go on; otherwise the node stays unconverged
+                # the label cap, not the clock: no bound from this call. At the root, withdraw
+                # the last cut round or raise the cap and go on; otherwise the node stays
+                # unconverged
                 s.stats.label_caps += 1
                 m.add_routes(pricer.columns(res))
                 if root is not None and root.label_cap():

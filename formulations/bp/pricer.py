@@ -79,8 +79,8 @@ class Pricer:
         improving route runs again with four times the cap, while that is below the exact
         calls' cap: labels are extended in order of energy, so a capped call has not reached
         the long routes, and ending the heuristic phase there hands its work to exact calls
-        that take tens of times longer (from about 360 points on; docs/bp-log.md, 2026-12-06
-        second day sitting)."""
+        that take tens of times longer (from about 360 points on; docs/bp.md, column
+        generation)."""
         while True:
             res = self.price(cost, ret, prof, allowed, heuristic=True, y0=y0, sig=sig)
             if (self.columns(res) or not res.stopped or self.search.clock.time_left() <= 0

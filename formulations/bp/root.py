@@ -1,15 +1,16 @@
 """The root's policy: what the root node gets beyond column generation.
 
 While its column generation runs (:class:`.colgen.RootSteps`): the caller's heuristic when the
-root is slow to settle (past ``primal_late_share`` of the limit with no plan sought yet); the
-certificate of every exact bound (its duals eliminate arcs and MILP columns,
+root is slow to settle (past ``primal_late_share`` of the limit with no plan sought since the
+start); the certificate of every exact bound (its duals eliminate arcs and MILP columns,
 :mod:`.elimination`); once the floored bound is settled, the first dive and, if it leaves the
 proof open, the caller's heuristic and a second dive over its columns, before the ng sets grow;
-the cut rounds last (:mod:`.cuts`), withdrawn when an exact pricing under them hits its label
-cap. Once its LP is solved (:meth:`Root.solve`): the labelling arc bounds (and the root again if
-they remove arcs), a dive from the final LP and the caller's heuristic again while the proof
-stays open. Route enumeration under the root's certificate (:mod:`.enumeration`) and the MILPs
-over the generated routes are run by the tree (:mod:`.tree`).
+the cut rounds last (:mod:`.cuts`); when an exact pricing hits its label cap, the last cut round
+is withdrawn, or with none left the cap grows (:meth:`Root.label_cap`). Once its LP is solved
+(:meth:`Root.solve`): the labelling arc bounds (and the root again if they remove arcs), a dive
+from the final LP and the caller's heuristic again while the proof stays open. Route
+enumeration under the root's certificate (:mod:`.enumeration`) and the MILPs over the generated
+routes are run by the tree (:mod:`.tree`).
 """
 
 from __future__ import annotations
