@@ -93,9 +93,12 @@ def _run_suite(suite, out_dir, workers, resume, scheduler, address, progress, st
         stored = len(payload) - len(todo)
         if store.repaired:
             log.warning("%s: dropped a half-written last row (a job in flight when the run was killed)", store.path)
-        where = f"Dask at {address if isinstance(address, str) else 'client'}" if scheduler else f"{workers} workers"
-        log.info("suite %s: %d jobs (%d instances × %d methods), %d already stored, %d to run on %s",
-                 suite.name, len(payload), suite.n_instances, len(suite.methods), stored, len(todo), where)
+        where = (f"Dask at {address if isinstance(address, str) else 'client'}" if scheduler
+                 else f"{workers} worker{'s' if workers != 1 else ''}")
+        # instance blocks may run a subset of the suite's methods: count what the jobs run
+        n_methods = len({job["method"] for job in payload})
+        log.info("suite %s: %d jobs (%d instances, %d methods), %d already stored, %d to run on %s",
+                 suite.name, len(payload), suite.n_instances, n_methods, stored, len(todo), where)
         t0 = time.monotonic()
         started = now()
         methods = sorted({job["method"] for job in todo})

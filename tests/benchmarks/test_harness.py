@@ -93,6 +93,18 @@ def test_methods_subset_then_rest_with_resume(tmp_path, capsys):
     assert len(err.splitlines()) == 1 and "'milp'" in err and "not one of the suite's methods" in err
 
 
+def test_the_start_line_counts_the_methods_the_jobs_run(tmp_path, caplog):
+    """The suite's start line counts the methods its jobs run (an instance block may run fewer
+    than the suite lists) and says "1 worker"."""
+    body = ('methods = ["greedy", "routing"]\ntime_limit = 5\n'
+            '[[instances]]\nM = 2\nK = 2\nN = 1\nruns = 2\nmethods = ["greedy"]\n')
+    suite = write_suite(tmp_path, body)
+    with caplog.at_level("INFO", logger="sarcover"):
+        assert main(["bench", str(suite), "-o", str(tmp_path / "res"), "--workers", "1"]) == 0
+    line = next(r.getMessage() for r in caplog.records if "already stored" in r.getMessage())
+    assert "2 jobs (2 instances, 1 methods)" in line and line.endswith("on 1 worker")
+
+
 def test_ctrl_c_in_a_worker_stops_the_run_without_storing_its_job(tmp_path, capsys):
     """A worker killed by SIGINT (Ctrl-C) exits 130 without storing its job, so --resume runs it again."""
     body = 'methods = ["bench_methods:interrupted"]\ntime_limit = 5\n[[instances]]\nM = 2\nK = 2\nN = 1\nruns = 1\n'
