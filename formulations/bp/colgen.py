@@ -76,14 +76,21 @@ class ColumnGeneration:
         self.ng_cap = ng_cap
         self.grow_until = grow_until
         self.root: RootSteps | None = None
+        # (duals, rc*) of the node's last exact pricing: every route's reduced prize under the
+        # duals is at most rc* (route enumeration at nodes lists under them)
+        self.priced: tuple[np.ndarray, float] | None = None
 
-    def solve(self, state: NodeState, bound: float):
+    def solve(self, state: NodeState, bound: float, targeted: bool = True):
         """Solve one node's LP by column generation, starting from the parent's ``bound``.
         Returns (bound, x, x_art, converged); not converged: out of time, or an exact pricing
         hit its label cap (at the root only once neither withdrawing the last cut round nor a
-        larger cap is left, see :meth:`.root.Root.label_cap`)."""
+        larger cap is left, see :meth:`.root.Root.label_cap`). Below the root the exact
+        pricing is targeted (it only proves what decides the node's floored bound) unless
+        ``targeted`` is False: then the LP converges fully, as route enumeration at the node
+        wants (:meth:`.enumeration.Enumeration.close_node`)."""
         s, m, pricer, elim = self.search, self.search.master, self.pricer, self.elimination
         root = self.root if state.depth == 0 else None
+        self.priced = None
         version = None
         arcs_decided = bool(state.forbidden_arcs or state.forced_arcs)
         x = xa = None
@@ -119,7 +126,8 @@ class ColumnGeneration:
             if s.clock.time_left() <= 0:
                 return bound, x, xa, False
             # below the root the exact pricing is targeted; the root's LP is converged
-            gain = y0 + (self.slack(m.lagrangian_bound(y, y0)) if root is None else 0.0)
+            gain = y0 + (self.slack(m.lagrangian_bound(y, y0)) if root is None and targeted
+                         else 0.0)
             res = pricer.exact(cost, ret, prof, allowed, gain, sig)
             s.stats.exact_pricings += 1
             if not res.exact:
@@ -136,6 +144,7 @@ class ColumnGeneration:
                 # x against every column the master holds now)
                 return bound, np.concatenate([x, np.zeros(m.n_routes - len(x))]), xa, False
             if res.exact:
+                self.priced = (y, max(0.0, res.best - y0))
                 lag = m.lagrangian_bound(y, res.best)
                 bound = min(bound, lag)
                 if root is not None:

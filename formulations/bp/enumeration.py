@@ -18,6 +18,7 @@ run as it was.
 
 from __future__ import annotations
 
+import logging
 import time
 from typing import TYPE_CHECKING
 
@@ -30,6 +31,8 @@ if TYPE_CHECKING:
     from sarcover.formulations.bp.elimination import Elimination
     from sarcover.formulations.bp.incumbent import IncumbentSearch
     from sarcover.formulations.bp.search import Search
+
+log = logging.getLogger(__name__)
 
 
 class Enumeration:
@@ -59,6 +62,7 @@ class Enumeration:
     # the MILP is only tried over at most this many routes: over 60 827 (M = 20, K = 4 seed
     # 111) HiGHS ran 150 s past a 100 s time limit, and every proof so far came from < 12 000
     MILP_MAX = 20_000
+    NODE_SHARE = 0.1  # a try at a node below the root: this share of ``limit``, a quarter of the labels
 
     def __init__(self, search: "Search", elimination: "Elimination",
                  incumbents: "IncumbentSearch", *, limit: float, gap: float, max_labels: int,
@@ -76,6 +80,7 @@ class Enumeration:
         self.cuts_per_round = cuts_per_round
         self._tried = None  # (certificate, incumbent value) of the last try
         self._wider = None  # the next narrow window to try with them (None: nothing left)
+        self._node_window = np.inf  # node tries only below this window (one at it was capped)
 
     def window(self) -> float | None:
         """Certificate bound - incumbent - one step, in prize steps: the slack a plan one step
@@ -95,7 +100,7 @@ class Enumeration:
     def close(self) -> bool:
         """One try; True when it proved the incumbent (possibly a new one, the MILP's) optimal.
         """
-        s, elim, m = self.search, self.elimination, self.search.master
+        s, elim = self.search, self.elimination
         window = self.window()
         if window is None:
             return False
@@ -106,33 +111,85 @@ class Enumeration:
         floor = elim.rc_floor()
         if not complete:  # only the routes within ``width`` steps of the best
             floor += (window - width) * s.problem.step
+        deadline = min(s.clock.deadline, time.perf_counter() + self.limit)
+        outcome, res = self._decide(cert.duals, floor, NodeState(), deadline, self.max_labels,
+                                    self._counted(width) * s.problem.step)
+        s.stats.enum_complete += complete
+        growth = self._growth(width, res)[0] if res.paths is not None else np.inf
+        s.stats.enum_growth = round(growth, 3) if np.isfinite(growth) else None
+        if outcome is None:
+            return False
+        if not complete:
+            if outcome == "infeasible":  # no better plan among the listed routes
+                self._widen(width, res)
+            return False
+        return outcome in ("infeasible", "optimal")
+
+    def node_window(self, dual_term: float) -> float | None:
+        """The window of a node below the root whose LP value is ``dual_term`` (steps above
+        incumbent + step), if a listing there may be tried: at most ``gap``, and after a
+        listing hit its cap, narrower than that one."""
+        s = self.search
+        if s.incumbent is None or s.clock.time_left() <= 0:
+            return None
+        window = (dual_term - s.incumbent_value - s.problem.step) / s.problem.step
+        return window if window <= min(self.gap, self._node_window) else None
+
+    def close_node(self, state: NodeState, y: np.ndarray, dual_term: float,
+                   rc_star: float) -> bool:
+        """A node below the root whose exact pricing under duals ``y`` (dual term
+        ``dual_term``) bounded every route's reduced prize by ``rc_star``: True when the
+        complete listing on the node's graph of the routes a plan better than the incumbent
+        may use (reduced prize >= incumbent + step - dual_term - (N - 1)·rc_star) holds no
+        such plan (its MILP may have raised the incumbent on the way)."""
+        s = self.search
+        window = self.node_window(dual_term)
+        if window is None:
+            return False
+        need = s.incumbent_value + s.problem.step
+        floor = need - dual_term - (s.problem.N - 1) * max(rc_star, 0.0) - 1e-6
+        deadline = min(s.clock.deadline, time.perf_counter() + self.limit * self.NODE_SHARE)
+        s.stats.node_enum_tries += 1
+        outcome, res = self._decide(y, floor, state, deadline, self.max_labels // 4, 0.0)
+        if res.paths is None:  # capped: only narrower windows from now on
+            self._node_window = window - 1e-9
+        closed = outcome in ("infeasible", "optimal")
+        s.stats.node_enum_closed += closed
+        log.debug("node listing: window %.3f, rc* %.4f, %d labels, %s routes: %s", window, rc_star,
+                  res.n_labels, None if res.paths is None else len(res.paths), outcome)
+        return closed
+
+    def _decide(self, y: np.ndarray, floor: float, state: NodeState, deadline: float,
+                max_labels: int, margin: float):
+        """List the routes of reduced prize >= ``floor`` under duals ``y`` on ``state``'s graph,
+        tighten the LP over them and solve the MILP over the routes left for a plan worth
+        incumbent + step. Returns (outcome, listing): outcome "infeasible" (no such plan among
+        the listed routes), "optimal" (the best such plan, now the incumbent), or None
+        (capped, out of time, too many routes for the MILP)."""
+        s, m, st = self.search, self.search.master, self.search.stats
         t = time.perf_counter()
-        deadline = min(s.clock.deadline, t + self.limit)
-        y = cert.duals
-        cost, _, allowed = node_graph(s, NodeState())
+        cost, _, allowed = node_graph(s, state)
         sig = np.zeros(len(m.cuts))
         cut = np.maximum(y[m.base_rows :], 0.0)[: len(m.cuts)]
         sig[: cut.size] = cut
-        st = s.stats
         st.enum_tries += 1
         try:
             res = enumerate_routes(cost, m.point_profit(y), allowed, s.problem.budget, y[0] + floor,
                                    ng=s.ng, cut_members=m.cut_members, cut_memory=m.cut_memory,
-                                   cut_duals=sig, max_labels=self.max_labels,
-                                   max_routes=self.max_routes, deadline=deadline,
-                                   margin=self._counted(width) * s.problem.step)
+                                   cut_duals=sig, max_labels=max_labels,
+                                   max_routes=self.max_routes, deadline=deadline, margin=margin)
         except MemoryError:  # a process memory limit below what the label cap allows
             st.enum_memory += 1
-            return False
+            return None, Enumerated(None, 0)
         finally:
             st.enum_s += time.perf_counter() - t
-        st.enum_complete += complete
         st.enum_labels = res.n_labels
         st.enum_routes = None if res.paths is None else len(res.paths)
-        growth = self._growth(width, res)[0] if res.paths is not None else np.inf
-        st.enum_growth = round(growth, 3) if np.isfinite(growth) else None
         if res.paths is None:
-            return False
+            return None, res
+        if len(res.paths) == 0:  # no route a better plan could use
+            st.enum_status = "infeasible"
+            return "infeasible", res
         need = s.incumbent_value + (s.problem.step if s.problem.integral else 1e-9)
         t = time.perf_counter()
         try:
@@ -140,17 +197,15 @@ class Enumeration:
             none_listed = self._tighten(lp, need, y, deadline)
         except MemoryError:
             st.enum_memory += 1
-            return False
+            return None, res
         finally:
             st.enum_lp_s += time.perf_counter() - t
         st.enum_left = len(lp)
         if none_listed:  # no plan worth need among the listed routes
             st.enum_status = "infeasible"
-            if not complete:
-                self._widen(width, res)
-            return complete
+            return "infeasible", res
         if time.perf_counter() >= deadline or len(lp) > self.MILP_MAX:
-            return False
+            return None, res
         t = time.perf_counter()
         status, plan = lp.milp(need, deadline - t)
         st.enum_milp_s += time.perf_counter() - t
@@ -160,16 +215,12 @@ class Enumeration:
             m.add_routes(plan)  # columns for the tree's LPs and dives too
             self.incumbents.offer(plan)
             st.enum_improved += s.incumbent_value > before
-        if not complete:
-            if status == "infeasible":  # no better plan among the listed routes
-                self._widen(width, res)
-            return False
-        if status == "infeasible":
-            return True
-        if status == "optimal" and plan is not None:
-            value = float(np.sum([m.prizes[np.asarray(r) - 1].sum() for r in plan]))
-            return s.incumbent_value >= value - 1e-6
-        return False
+        if status == "optimal":
+            value = (np.inf if plan is None
+                     else float(np.sum([m.prizes[np.asarray(r) - 1].sum() for r in plan])))
+            if s.incumbent_value < value - 1e-6:
+                return None, res
+        return (status if status in ("infeasible", "optimal") else None), res
 
     def _widen(self, width: float, res: "Enumerated") -> None:
         """After a narrow try that listed no better plan: the next, ``WIDEN`` steps wider, if

@@ -122,7 +122,9 @@ class BranchAndPrice:
                         inc.run_milp(min(10.0, 0.25 * s.clock.time_left()))
                         last_milp_cols = m.n_routes
                 else:
-                    bound, x, xa, converged = self.colgen.solve(state, parent_bound)
+                    bound, x, xa, converged = self._solve_node(state, parent_bound)
+                    if bound is None:
+                        continue  # closed by listing its routes
                 if not converged and s.clock.time_left() <= 0:
                     heapq.heappush(heap, self._node_key(bound, state.depth, counter, state))
                     counter += 1
@@ -177,6 +179,26 @@ class BranchAndPrice:
             # the time kept in reserve: a last MILP over everything generated
             inc.run_milp(max(0.0, s.clock.hard_deadline - time.perf_counter() - 0.1))
         return self._close([-item[2] for item in heap], unresolved, proven)
+
+    def _solve_node(self, state: NodeState, parent_bound: float):
+        """Column generation at a node below the root: (bound, x, x_art, converged), bound None
+        when the node was closed by route enumeration. A converged node whose LP value lies
+        within the enumeration's window of the incumbent converges fully (untargeted pricing),
+        then its routes are listed (:meth:`.enumeration.Enumeration.close_node`)."""
+        s, m, enum = self.search, self.search.master, self.enumeration
+        bound, x, xa, converged = self.colgen.solve(state, parent_bound)
+        if enum is None or not converged or s.prunable(bound) or self.colgen.priced is None:
+            return bound, x, xa, converged
+        y = self.colgen.priced[0]
+        if enum.node_window(m.lagrangian_bound(y, y[0])) is None:
+            return bound, x, xa, converged
+        bound, x, xa, converged = self.colgen.solve(state, bound, targeted=False)
+        if not converged or s.prunable(bound) or self.colgen.priced is None:
+            return bound, x, xa, converged
+        y, rc_star = self.colgen.priced
+        if enum.close_node(state, y, m.lagrangian_bound(y, y[0]), rc_star):
+            return None, x, xa, converged
+        return bound, x, xa, converged
 
     def _close(self, open_bounds: list, unresolved: list, finished: bool):
         """(proven, bound) from the nodes left open (their bounds) and those that could not be

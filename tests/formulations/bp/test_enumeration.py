@@ -53,7 +53,9 @@ def test_enumeration_out_of_memory_gives_up_the_try(monkeypatch, where):
     assert tried.info["enum_tries"] == 1 and tried.info["enum_status"] == "infeasible"  # the try closes it
     monkeypatch.setattr(enumeration, where, out_of_memory)
     res = solve_bp(inst, time_limit=60, options=BPOptions(enum_share=0.5, enum_gap=1.0))
-    assert res.info["enum_memory"] == 1 and res.info["enum_status"] is None
+    # every try gives up: the root's, and the nodes' that follow it
+    assert res.info["enum_memory"] == res.info["enum_tries"] >= 1
+    assert res.info["enum_status"] is None
     assert res.status == Status.OPTIMAL
     assert verify(inst, res.plan).prize == pytest.approx(verify(inst, tried.plan).prize)
 
@@ -106,3 +108,39 @@ def test_widening_is_guarded_by_the_growth_at_the_rim():
     assert widened(0.05, 16_000, 400) == pytest.approx(0.15)
     assert widened(0.05, 15_999, 400) is None and widened(0.05, 16_000, 399) is None
     assert Enumerated(None, 7).growth() == (np.inf, np.inf)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_node_listing_decides_exactly(seed):
+    """Under any duals and a bound on every route's reduced prize under them, a node's listing
+    holds every route a better plan may use: under duals of 0 (a route's reduced prize is its
+    prize, at most the total) it finds the brute-force optimum from the empty plan and then
+    proves it; on the graph of a node that forbids a point, the best plan without that point."""
+    from sarcover.formulations.bp.compile import warm_up
+    from sarcover.formulations.bp.graph import NodeState
+    from sarcover.formulations.bp.tree import BranchAndPrice
+
+    from bp_cases import brute_force, random_tiny
+
+    warm_up()  # compiling is not charged to the listing's deadline
+    inst = random_tiny(seed, groups=False)
+    total = float(inst.prizes.sum())
+    bp = BranchAndPrice(inst, time_limit=30, options=BPOptions(enum_share=0.5))
+    s, m = bp.search, bp.search.master
+    assert s.incumbent_value == 0.0
+    root = NodeState()
+    m.apply(root)
+    y = np.zeros(m.n_rows)
+    assert bp.enumeration.close_node(root, y, 0.0, total)  # finds the optimum
+    assert s.incumbent_value == brute_force(inst)
+    assert bp.enumeration.close_node(root, y, 0.0, total)  # nothing beats it
+    assert (s.stats.node_enum_tries, s.stats.node_enum_closed) == (2, 2)
+
+    point = int(np.argmax(inst.prizes))
+    without = dataclasses.replace(inst, prizes=np.where(np.arange(inst.n_nodes) == point, 0.0,
+                                                        inst.prizes))
+    bp = BranchAndPrice(inst, time_limit=30, options=BPOptions(enum_share=0.5))
+    node = root.child(forbidden_nodes=[point + 1])
+    bp.search.master.apply(node)
+    assert bp.enumeration.close_node(node, y, 0.0, total)
+    assert bp.search.incumbent_value == brute_force(without)
