@@ -25,7 +25,7 @@ The parts, one idea a module. The search:
 - :mod:`.pricer`: the labelling as the search calls it (timed, counted, its direction);
 - :mod:`.cuts`: limited-memory subset-row cut rounds at the root;
 - :mod:`.elimination`: reduced-cost arc elimination and MILP column filter under the root's duals;
-- :mod:`.enumeration`: closing the root gap by route enumeration and a MILP over the routes;
+- :mod:`.enumeration`: closing the root gap or a node by route enumeration and a MILP over its routes;
 - :mod:`.enumerated_lp`: the LP over the enumerated routes, with full-memory cuts;
 - :mod:`.incumbent`: plans: dives, the MILP over the generated routes, the caller's heuristic;
 - :mod:`.branching`: branching candidates and strong branching;

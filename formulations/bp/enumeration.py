@@ -14,6 +14,12 @@ row "prize >= incumbent + step" decide the run: a solution is an optimal plan (e
 is among its columns), an LP below that value or an infeasible MILP proves the incumbent
 optimal. Both only hold when the listing and the MILP finished; a cap or a time limit leaves the
 run as it was.
+
+The same holds below the root under a node's own duals, on the node's graph
+(:meth:`Enumeration.close_node`): the LP falls by a few tenths per branching, so a node's window
+gets narrow enough to list long before its floored bound reaches the incumbent, and the listing
+closes the node (its plans are among the listed routes; the branching rows need not be in the
+LP or the MILP, which only relax them).
 """
 
 from __future__ import annotations
@@ -62,7 +68,7 @@ class Enumeration:
     # the MILP is only tried over at most this many routes: over 60 827 (M = 20, K = 4 seed
     # 111) HiGHS ran 150 s past a 100 s time limit, and every proof so far came from < 12 000
     MILP_MAX = 20_000
-    NODE_SHARE = 0.1  # a try at a node below the root: this share of ``limit``, a quarter of the labels
+    NODE_SHARE = 0.1  # a try at a node below the root: this share of ``limit``, a quarter of its labels
 
     def __init__(self, search: "Search", elimination: "Elimination",
                  incumbents: "IncumbentSearch", *, limit: float, gap: float, max_labels: int,
@@ -132,8 +138,13 @@ class Enumeration:
         s = self.search
         if s.incumbent is None or s.clock.time_left() <= 0:
             return None
-        window = (dual_term - s.incumbent_value - s.problem.step) / s.problem.step
+        window = (dual_term - self._need()) / s.problem.step
         return window if window <= min(self.gap, self._node_window) else None
+
+    def _need(self) -> float:
+        """The value a plan must reach to beat the incumbent."""
+        s = self.search
+        return s.incumbent_value + (s.problem.step if s.problem.integral else 1e-9)
 
     def close_node(self, state: NodeState, y: np.ndarray, dual_term: float,
                    rc_star: float) -> bool:
@@ -146,7 +157,7 @@ class Enumeration:
         window = self.node_window(dual_term)
         if window is None:
             return False
-        need = s.incumbent_value + s.problem.step
+        need = self._need()
         floor = need - dual_term - (s.problem.N - 1) * max(rc_star, 0.0) - 1e-6
         deadline = min(s.clock.deadline, time.perf_counter() + self.limit * self.NODE_SHARE)
         s.stats.node_enum_tries += 1
@@ -190,7 +201,7 @@ class Enumeration:
         if len(res.paths) == 0:  # no route a better plan could use
             st.enum_status = "infeasible"
             return "infeasible", res
-        need = s.incumbent_value + (s.problem.step if s.problem.integral else 1e-9)
+        need = self._need()
         t = time.perf_counter()
         try:
             lp = EnumeratedLP(m, res.paths, cuts=zip(m.cuts, m.memories))

@@ -6,7 +6,10 @@ plan of the best floored value turns up); a node is pruned when its floored boun
 the incumbent. The root gets more than the other nodes (its policy: :mod:`.root`), and a MILP
 over the generated routes once it is solved; later nodes get a dive every ``dive_every`` nodes
 and a MILP every ``milp_every`` nodes, and before each, route enumeration under the root's
-certificate (:mod:`.enumeration`) is tried when the certificate or the incumbent has changed.
+certificate (:mod:`.enumeration`) is tried when the certificate or the incumbent has changed. A
+node whose LP value comes within the enumeration's window of the incumbent is converged fully
+and its routes listed under its own duals, which can close it without branching
+(:meth:`BranchAndPrice._solve_node`).
 The reported bound is max(incumbent, floored bounds of the open nodes), certified at every stop;
 a run whose open nodes all floor to the incumbent is proven.
 """

@@ -144,3 +144,24 @@ def test_a_node_listing_decides_exactly(seed):
     bp.search.master.apply(node)
     assert bp.enumeration.close_node(node, y, 0.0, total)
     assert bp.search.incumbent_value == brute_force(without)
+
+
+def test_node_listings_close_nodes_and_keep_the_optimum(monkeypatch):
+    """With the root's listing off and no cuts (so that these small instances branch), listings
+    at nodes close some of them, and the tree proves the optimum bp proves without enumeration."""
+    from sarcover.formulations.bp.enumeration import Enumeration
+
+    plain = {}
+    for case in [(12, 3, 3, 0), (12, 4, 3, 0), (12, 4, 3, 4)]:
+        plain[case] = solve_bp(to_top(generate(*case)), time_limit=30)
+    monkeypatch.setattr(Enumeration, "close", lambda self: False)
+    closed = 0
+    for case, ref in plain.items():
+        inst = to_top(generate(*case))
+        res = solve_bp(inst, time_limit=30, options=BPOptions(enum_share=0.5, enum_gap=1.0,
+                                                              cut_rounds=0))
+        assert ref.status == res.status == Status.OPTIMAL
+        assert res.info["nodes"] > 1 and res.info["enum_tries"] == res.info["node_enum_tries"]
+        assert verify(inst, res.plan).prize == pytest.approx(verify(inst, ref.plan).prize)
+        closed += res.info["node_enum_closed"]
+    assert closed >= 1
