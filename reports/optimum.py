@@ -80,7 +80,7 @@ TUNED_ON = {
     (3, 5): "second primal call; enumeration from 60 s and its label cap",
     (3, 6): "second primal call; enumeration from 60 s and its label cap; sub-buckets (seed 117)",
     (4, 5): "enumeration's LP stall and MILP route cap (seed 111)",
-    (5, 5): "route enumeration settings; 30 s primal calls",
+    (5, 5): "route enumeration settings; 30 s primal calls; node listings (seeds 104, 108)",
     (6, 5): "4 primal calls from 600 s; 30 s primal calls",
 }
 

@@ -176,7 +176,8 @@ def test_proof_table_says_when_validation_has_not_run(tmp_path):
     text = write_reference(root, tmp_path / "out", suites=SUITES).read_text()
     assert "has not been run" not in text and "(seeds 200..204) that chose nothing" in text
     line = next(x for x in text.splitlines() if x.startswith("| K=5 N=5 | 300 |"))
-    assert line.endswith("| 2/4 (50 %) | route enumeration settings; 30 s primal calls | 4/5 (80 %) | 2 / 2 |")
+    assert line.endswith("| 2/4 (50 %) | route enumeration settings; 30 s primal calls; node listings "
+                         "(seeds 104, 108) | 4/5 (80 %) | 2 / 2 |")
     assert "| K=4 N=5 | 300 | – | enumeration's LP stall" in text and "no rows yet" in text
     csv = pd.read_csv(tmp_path / "out" / "paper_validation.csv").set_index("setting")
     assert csv.loc["K=5 N=5", "validation_proven"] == 4
