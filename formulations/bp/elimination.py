@@ -66,8 +66,7 @@ class Elimination:
         s = self.search
         if self.cert is None or s.incumbent is None:
             return None
-        need = s.incumbent_value + (s.problem.step if s.problem.integral else 1e-9)
-        return need - self.cert.dual_term - (s.problem.N - 1) * self.cert.rc_star - 1e-6
+        return s.need() - self.cert.dual_term - (s.problem.N - 1) * self.cert.rc_star - 1e-6
 
     def milp_columns(self):
         """(n_routes,) bool: the routes that can be part of a plan better than the incumbent.

@@ -138,13 +138,8 @@ class Enumeration:
         s = self.search
         if s.incumbent is None or s.clock.time_left() <= 0:
             return None
-        window = (dual_term - self._need()) / s.problem.step
+        window = (dual_term - s.need()) / s.problem.step
         return window if window <= min(self.gap, self._node_window) else None
-
-    def _need(self) -> float:
-        """The value a plan must reach to beat the incumbent."""
-        s = self.search
-        return s.incumbent_value + (s.problem.step if s.problem.integral else 1e-9)
 
     def close_node(self, state: NodeState, y: np.ndarray, dual_term: float,
                    rc_star: float) -> bool:
@@ -157,7 +152,7 @@ class Enumeration:
         window = self.node_window(dual_term)
         if window is None:
             return False
-        need = self._need()
+        need = s.need()
         floor = need - dual_term - (s.problem.N - 1) * max(rc_star, 0.0) - 1e-6
         deadline = min(s.clock.deadline, time.perf_counter() + self.limit * self.NODE_SHARE)
         s.stats.node_enum_tries += 1
@@ -201,7 +196,7 @@ class Enumeration:
         if len(res.paths) == 0:  # no route a better plan could use
             st.enum_status = "infeasible"
             return "infeasible", res
-        need = self._need()
+        need = s.need()
         t = time.perf_counter()
         try:
             lp = EnumeratedLP(m, res.paths, cuts=zip(m.cuts, m.memories))

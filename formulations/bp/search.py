@@ -42,6 +42,11 @@ class Search:
             return b < -TOL  # no plan (prize >= 0) exists below this node
         return b <= self.incumbent_value + TOL
 
+    def need(self) -> float:
+        """The value a plan must reach to beat the incumbent: the next lattice point with
+        integer prizes, anything above it otherwise."""
+        return self.incumbent_value + (self.problem.step if self.problem.integral else 1e-9)
+
     def log(self, bound: float | None = None) -> None:
         """One point of the history: (seconds since the start, incumbent, bound)."""
         inc = None if self.incumbent is None else self.incumbent_value
