@@ -77,14 +77,21 @@ class Solved(NamedTuple):
 
 
 class EnumeratedLP:
-    """The route master's root rows (vehicles, each point at most once, each group covered)
-    over the routes ``paths`` (rows of solver points, -1 padded), plus subset-row cut rows.
-    ``cuts``: (triple, memory) pairs of the master's limited-memory cuts to start with."""
+    """The route master's rows (vehicles, each point at most once, each group covered) over the
+    routes ``paths`` (rows of solver points, -1 padded), plus subset-row cut rows. ``cuts``:
+    (triple, memory) pairs of the master's limited-memory cuts to start with; ``rows``: (lo, hi)
+    of the master's rows at the node whose routes these are (:meth:`.master.Master.node_rows`:
+    a forced point's row at ``= 1``, group bounds), None for the root's."""
 
     BATCH = 2000  # columns added to the LP per round of pricing by inspection
 
-    def __init__(self, master, paths: np.ndarray, cuts=()):
+    def __init__(self, master, paths: np.ndarray, cuts=(), rows=None):
         self.master = master
+        lo, hi = (master.row_lo, master.row_hi) if rows is None else rows
+        self.row_lo, self.row_hi = lo[: master.base_rows], hi[: master.base_rows]
+        # artificial columns on the rows with a positive lower bound (group covers, forced
+        # points), so that every restricted LP is feasible
+        self.art_rows = np.flatnonzero(self.row_lo > 0).astype(np.int32)
         self.n_points = master.V + 2
         self.cuts: list[tuple] = []  # (triple, memory or None for full memory)
         self._set_routes(np.ascontiguousarray(paths, dtype=np.int32))
@@ -152,17 +159,16 @@ class EnumeratedLP:
 
     def _build(self) -> None:
         m = self.master
-        nb, nc = m.base_rows, len(self.cuts)
-        lo = np.concatenate([m.row_lo[:nb], np.full(nc, -INF)])
-        hi = np.concatenate([m.row_hi[:nb], np.ones(nc)])
+        nc = len(self.cuts)
+        lo = np.concatenate([self.row_lo, np.full(nc, -INF)])
+        hi = np.concatenate([self.row_hi, np.ones(nc)])
         h = quiet_highs()
         h.changeObjectiveSense(highspy.ObjSense.kMaximize)
         h.addRows(lo.size, lo, hi, 0, np.zeros(lo.size, np.int32), np.zeros(0, np.int32),
                   np.zeros(0))
-        # artificials for the group rows (>= 1), so that every restricted LP is feasible
-        g_rows = np.arange(1 + m.V, 1 + m.V + m.G, dtype=np.int32)
-        h.addCols(m.G, np.full(m.G, -m.big), np.zeros(m.G), np.full(m.G, INF), m.G,
-                  np.arange(m.G, dtype=np.int32), g_rows, np.ones(m.G))
+        na = self.art_rows.size
+        h.addCols(na, np.full(na, -m.big), np.zeros(na), np.full(na, INF), na,
+                  np.arange(na, dtype=np.int32), self.art_rows, np.ones(na))
         self.h, self.lo, self.hi = h, lo, hi
         self.A = self.matrix()
         self.cols = np.zeros(0, np.int64)  # the LP's route columns, as route indices
@@ -209,7 +215,7 @@ class EnumeratedLP:
             if new.size == 0:
                 break
             self._add_columns(new[np.argsort(-rc[new], kind="stable")[: self.BATCH]])
-        xv = np.asarray(sol.col_value)[self.master.G :]
+        xv = np.asarray(sol.col_value)[self.art_rows.size :]
         x = {int(self.cols[j]): float(xv[j]) for j in np.flatnonzero(xv > 1e-9)}
         term = np.where(y > 0, y * np.where(np.isinf(self.hi), 0.0, self.hi),
                         y * np.where(np.isinf(self.lo), 0.0, self.lo))
@@ -225,7 +231,7 @@ class EnumeratedLP:
 
     def milp(self, need: float, time_limit: float, *, cuts: bool = False):
         """The best plan of listed routes among those worth at least ``need`` (set packing over
-        the root rows and the row "prize >= need"; with ``cuts`` also the cut rows, valid for
+        its rows and the row "prize >= need"; with ``cuts`` also the cut rows, valid for
         every plan). Returns (status, routes): ("optimal", plan), ("infeasible", None): no such
         plan, or ("open", plan or None) at the time limit. Without the cut rows by default: on
         M = 20, K = 5 seed 100 HiGHS found the plan worth ``need`` among 6 413 routes in 15 s
@@ -236,8 +242,8 @@ class EnumeratedLP:
         a = sp.hstack([self.base, sp.csr_matrix(self.prize[:, None])]
                       + ([self.cut_matrix] if cuts else []), format="csr")
         n_cuts = a.shape[1] - m.base_rows - 1
-        lo = np.concatenate([m.row_lo[: m.base_rows], [need], np.full(n_cuts, -INF)])
-        hi = np.concatenate([m.row_hi[: m.base_rows], [INF], np.ones(n_cuts)])
+        lo = np.concatenate([self.row_lo, [need], np.full(n_cuts, -INF)])
+        hi = np.concatenate([self.row_hi, [INF], np.ones(n_cuts)])
         # the rows of ``a`` are the routes: its CSR arrays are the CSC arrays of the columns
         h = packing_milp(lo, hi, self.prize, np.ones(k), a.indptr[:-1].astype(np.int32),
                          a.indices.astype(np.int32), a.data, time_limit, abs_gap=True)

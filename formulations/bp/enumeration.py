@@ -18,8 +18,8 @@ run as it was.
 The same holds below the root under a node's own duals, on the node's graph
 (:meth:`Enumeration.close_node`): the LP falls by a few tenths per branching, so a node's window
 gets narrow enough to list long before its floored bound reaches the incumbent, and the listing
-closes the node (its plans are among the listed routes; the branching rows need not be in the
-LP or the MILP, which only relax them).
+closes the node (its plans are among the listed routes, and they meet the node's rows: a forced
+point's row is ``= 1`` in the LP and the MILP over them).
 """
 
 from __future__ import annotations
@@ -68,7 +68,8 @@ class Enumeration:
     # the MILP is only tried over at most this many routes: over 60 827 (M = 20, K = 4 seed
     # 111) HiGHS ran 150 s past a 100 s time limit, and every proof so far came from < 12 000
     MILP_MAX = 20_000
-    NODE_SHARE = 0.1  # a try at a node below the root: this share of ``limit``, a quarter of its labels
+    NODE_SHARE = 0.1  # a try at a node below the root: this share of ``limit`` ...
+    NODE_LABELS = 0.25  # ... and this share of ``max_labels``
 
     def __init__(self, search: "Search", elimination: "Elimination",
                  incumbents: "IncumbentSearch", *, limit: float, gap: float, max_labels: int,
@@ -121,6 +122,9 @@ class Enumeration:
         outcome, res = self._decide(cert.duals, floor, NodeState(), deadline, self.max_labels,
                                     self._counted(width) * s.problem.step)
         s.stats.enum_complete += complete
+        log.debug("root listing: window %.3f, width %s, %d labels, %s routes: %s", window,
+                  "all" if complete else f"{width:.2f}", res.n_labels,
+                  None if res.paths is None else len(res.paths), outcome)
         growth = self._growth(width, res)[0] if res.paths is not None else np.inf
         s.stats.enum_growth = round(growth, 3) if np.isfinite(growth) else None
         if outcome is None:
@@ -156,7 +160,7 @@ class Enumeration:
         floor = need - dual_term - (s.problem.N - 1) * max(rc_star, 0.0) - 1e-6
         deadline = min(s.clock.deadline, time.perf_counter() + self.limit * self.NODE_SHARE)
         s.stats.node_enum_tries += 1
-        outcome, res = self._decide(y, floor, state, deadline, self.max_labels // 4, 0.0)
+        outcome, res = self._decide(y, floor, state, deadline, int(self.max_labels * self.NODE_LABELS), 0.0)
         if res.paths is None:  # capped: only narrower windows from now on
             self._node_window = window - 1e-9
         closed = outcome in ("infeasible", "optimal")
@@ -199,7 +203,8 @@ class Enumeration:
         need = s.need()
         t = time.perf_counter()
         try:
-            lp = EnumeratedLP(m, res.paths, cuts=zip(m.cuts, m.memories))
+            lp = EnumeratedLP(m, res.paths, cuts=zip(m.cuts, m.memories),
+                              rows=m.node_rows(state))
             none_listed = self._tighten(lp, need, y, deadline)
         except MemoryError:
             st.enum_memory += 1

@@ -369,6 +369,17 @@ class Master:
                 mem = {u for u in mem if ng[w, u >> 6] >> np.uint64(u & 63) & np.uint64(1)} | {w}
         return n
 
+    def node_rows(self, state) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi) bounds of every row at a node: the root's, with each forced point's row at
+        ``= 1`` and each group bound on its group's row."""
+        lo, hi = self.row_lo.copy(), self.row_hi.copy()
+        for p in state.forced_nodes:
+            lo[p] = 1.0
+        for g, g_lo, g_hi in state.group_bounds:  # views of target g within [g_lo, g_hi]
+            row = 1 + self.V + g
+            lo[row], hi[row] = max(lo[row], g_lo), min(hi[row], g_hi)
+        return lo, hi
+
     def apply(self, state) -> None:
         """Set column and row bounds for a branch-and-bound node."""
         k = self.n_routes
@@ -378,13 +389,7 @@ class Master:
             cols = (changed + self.n_art).astype(np.int32)
             self.h.changeColsBounds(cols.size, cols, np.zeros(cols.size), ub[changed])
             self.col_ub = ub
-        lo, hi = self.row_lo.copy(), self.row_hi.copy()
-        for p in state.forced_nodes:
-            lo[p] = 1.0
-        for g, g_lo, g_hi in state.group_bounds:  # views of target g within [g_lo, g_hi]
-            row = 1 + self.V + g
-            lo[row], hi[row] = max(lo[row], g_lo), min(hi[row], g_hi)
-        self.cur_lo, self.cur_hi = lo, hi
+        self.cur_lo, self.cur_hi = lo, hi = self.node_rows(state)
         rows = np.arange(1, 1 + self.V + self.G, dtype=np.int32)
         self.h.changeRowsBounds(rows.size, rows, lo[rows], hi[rows])
         assert k == self.col_ub.size

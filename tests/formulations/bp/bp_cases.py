@@ -28,8 +28,9 @@ def feasible_routes(inst: TOPInstance) -> list[tuple[int, ...]]:
     return routes
 
 
-def brute_force(inst: TOPInstance) -> float | None:
-    """Best prize over all plans of a tiny instance (None if no plan covers every group)."""
+def brute_force(inst: TOPInstance, visit: int | None = None) -> float | None:
+    """Best prize over all plans of a tiny instance (None if no plan covers every group), among
+    those that visit node ``visit`` if given."""
     sets = {frozenset(r) for r in feasible_routes(inst)}
     best = None
     for combo in itertools.combinations_with_replacement(sorted(sets, key=sorted), inst.n_vehicles):
@@ -37,7 +38,8 @@ def brute_force(inst: TOPInstance) -> float | None:
         if len(nodes) != len(set(nodes)):
             continue
         seen = set(nodes)
-        if any(not seen.intersection(g) for g in inst.groups):
+        if any(not seen.intersection(g) for g in inst.groups) or (visit is not None
+                                                                  and visit not in seen):
             continue
         prize = float(sum(inst.prizes[i] for i in seen))
         best = prize if best is None else max(best, prize)

@@ -110,12 +110,14 @@ def test_widening_is_guarded_by_the_growth_at_the_rim():
     assert Enumerated(None, 7).growth() == (np.inf, np.inf)
 
 
-@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("seed", range(7))
 def test_a_node_listing_decides_exactly(seed):
     """Under any duals and a bound on every route's reduced prize under them, a node's listing
     holds every route a better plan may use: under duals of 0 (a route's reduced prize is its
     prize, at most the total) it finds the brute-force optimum from the empty plan and then
-    proves it; on the graph of a node that forbids a point, the best plan without that point."""
+    proves it; on the graph of a node that forbids a point, the best plan without that point;
+    at a node that forces the reachable point that costs most to visit, the best plan that
+    visits it (below the optimum on seed 6)."""
     from sarcover.formulations.bp.compile import warm_up
     from sarcover.formulations.bp.graph import NodeState
     from sarcover.formulations.bp.tree import BranchAndPrice
@@ -144,6 +146,14 @@ def test_a_node_listing_decides_exactly(seed):
     bp.search.master.apply(node)
     assert bp.enumeration.close_node(node, y, 0.0, total)
     assert bp.search.incumbent_value == brute_force(without)
+
+    bp = BranchAndPrice(inst, time_limit=30, options=BPOptions(enum_share=0.5))
+    reachable = np.flatnonzero(bp.search.problem.reachable[1 : inst.n_nodes + 1])
+    costly = min(reachable.tolist(), key=lambda p: brute_force(inst, visit=p))
+    node = root.child(forced_nodes=[costly + 1])
+    bp.search.master.apply(node)
+    assert bp.enumeration.close_node(node, y, 0.0, total)
+    assert bp.search.incumbent_value == brute_force(inst, visit=costly)
 
 
 def test_node_listings_close_nodes_and_keep_the_optimum(monkeypatch):
