@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 from sarcover.formulations.bp.arc_bounds import arc_bounds, label_arc_bounds
 from sarcover.formulations.bp.graph import NodeState, node_graph
+from sarcover.formulations.bp.master import route_floor
 
 if TYPE_CHECKING:
     from sarcover.formulations.bp.search import Search
@@ -66,7 +67,7 @@ class Elimination:
         s = self.search
         if self.cert is None or s.incumbent is None:
             return None
-        return s.need() - self.cert.dual_term - (s.problem.N - 1) * self.cert.rc_star - 1e-6
+        return route_floor(s.need(), self.cert.dual_term, self.cert.rc_star, s.problem.N)
 
     def milp_columns(self):
         """(n_routes,) bool: the routes that can be part of a plan better than the incumbent.

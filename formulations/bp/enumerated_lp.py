@@ -26,7 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 from sarcover.formulations.bp.highs import INF, packing_milp, quiet_highs, solve_lp
-from sarcover.formulations.bp.master import spread, violated_triples
+from sarcover.formulations.bp.master import dual_term, route_floor, spread, violated_triples
 
 
 @njit(cache=True)
@@ -73,7 +73,7 @@ class Solved(NamedTuple):
 
     def floor(self, need: float, n_vehicles: int) -> float:
         """The reduced prize a route needs to be part of a plan worth ``need``."""
-        return need - self.dual_term - (n_vehicles - 1) * self.rc_star - 1e-6
+        return route_floor(need, self.dual_term, self.rc_star, n_vehicles)
 
 
 class EnumeratedLP:
@@ -217,9 +217,7 @@ class EnumeratedLP:
             self._add_columns(new[np.argsort(-rc[new], kind="stable")[: self.BATCH]])
         xv = np.asarray(sol.col_value)[self.art_rows.size :]
         x = {int(self.cols[j]): float(xv[j]) for j in np.flatnonzero(xv > 1e-9)}
-        term = np.where(y > 0, y * np.where(np.isinf(self.hi), 0.0, self.hi),
-                        y * np.where(np.isinf(self.lo), 0.0, self.lo))
-        return Solved(float(term.sum()), max(0.0, float(rc.max(initial=0.0))), x, rc)
+        return Solved(dual_term(y, self.lo, self.hi), max(0.0, float(rc.max(initial=0.0))), x, rc)
 
     def keep(self, mask: np.ndarray) -> None:
         """Keep only the routes where ``mask`` is True (the LP is rebuilt on the next solve)."""

@@ -32,6 +32,7 @@ import numpy as np
 from sarcover.formulations.bp.enumerated_lp import EnumeratedLP
 from sarcover.formulations.bp.enumeration_kernel import Enumerated, enumerate_routes
 from sarcover.formulations.bp.graph import NodeState, node_graph
+from sarcover.formulations.bp.master import route_floor
 
 if TYPE_CHECKING:
     from sarcover.formulations.bp.elimination import Elimination
@@ -156,11 +157,11 @@ class Enumeration:
         window = self.node_window(dual_term)
         if window is None:
             return False
-        need = s.need()
-        floor = need - dual_term - (s.problem.N - 1) * max(rc_star, 0.0) - 1e-6
+        floor = route_floor(s.need(), dual_term, rc_star, s.problem.N)
         deadline = min(s.clock.deadline, time.perf_counter() + self.limit * self.NODE_SHARE)
         s.stats.node_enum_tries += 1
-        outcome, res = self._decide(y, floor, state, deadline, int(self.max_labels * self.NODE_LABELS), 0.0)
+        labels = int(self.max_labels * self.NODE_LABELS)
+        outcome, res = self._decide(y, floor, state, deadline, labels, 0.0)
         if res.paths is None:  # capped: only narrower windows from now on
             self._node_window = window - 1e-9
         closed = outcome in ("infeasible", "optimal")

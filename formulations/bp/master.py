@@ -87,6 +87,21 @@ def violated_triples(vis: np.ndarray, xp: np.ndarray, have, min_violation: float
     return [S for _, S in found]
 
 
+def dual_term(y: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float:
+    """The duals' part of a Lagrangian bound: each row's dual times the bound it sits at (its
+    upper bound where the dual is positive, its lower bound where negative); duals clipped to
+    their signs, as :meth:`Master.solve` returns them."""
+    return float(np.where(y > 0, y * np.where(np.isinf(hi), 0.0, hi),
+                          y * np.where(np.isinf(lo), 0.0, lo)).sum())
+
+
+def route_floor(need: float, term: float, rc_star: float, n_vehicles: int) -> float:
+    """The reduced prize a route needs to be part of a plan worth ``need`` under duals of dual
+    term ``term`` that bound every route's reduced prize by ``rc_star``: such a plan is worth at
+    most term + its routes' reduced prizes, the others' at most ``rc_star`` each."""
+    return need - term - (n_vehicles - 1) * max(rc_star, 0.0) - 1e-6
+
+
 def spread(triples, room: int, per_point: int = 3) -> list:
     """Up to ``room`` of ``triples`` in order, a point in at most ``per_point`` of them (cuts on
     the same few points overlap and lower the LP less)."""
@@ -417,10 +432,8 @@ class Master:
 
     def lagrangian_bound(self, y: np.ndarray, best_path_prize: float) -> float:
         """Certified upper bound from duals y and an upper bound on the best path's reduced prize."""
-        lo, hi = self.cur_lo, self.cur_hi
-        term = np.where(y > 0, y * np.where(np.isinf(hi), 0.0, hi), y * np.where(np.isinf(lo), 0.0, lo))
         rc_star = max(0.0, best_path_prize - y[0])
-        return float(term.sum() + self.N * rc_star)
+        return dual_term(y, self.cur_lo, self.cur_hi) + self.N * rc_star
 
     def reduced_costs(self, y: np.ndarray) -> np.ndarray:
         """(n_routes,) reduced prize p_r - A_r·y of every route for duals ``y``; rows added after
