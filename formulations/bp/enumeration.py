@@ -55,16 +55,19 @@ class Enumeration:
     (the threshold raised by the difference), and the MILP over them can only find a better
     plan. The plan one step above the incumbent has a total slack of the window over its
     routes, so most of its routes sit well inside a narrow window. A narrow try that finds no
-    plan is followed by one ``WIDEN`` steps wider (with the same certificate and incumbent) if
-    its labels and routes, times their growth at the narrow listing's rim (over its last
-    ``WIDEN`` steps, or all of it if narrower, extrapolated geometrically to ``WIDEN`` steps:
-    :meth:`Enumerated.growth`), stay within the caps; a try as wide as the window is complete.
+    plan is followed by a wider one (with the same certificate and incumbent) if its labels and
+    routes, times their growth at the narrow listing's rim (over its last ``WIDEN`` steps, or
+    all of it if narrower, extrapolated geometrically: :meth:`Enumerated.growth`), stay within
+    the caps; a try as wide as the window is complete. The first widening adds ``WIDEN`` steps
+    and each next one twice the last, or less (halved down to ``WIDEN``) where the caps call
+    for it: at a window of ten steps (TOP's 100-point files) the listings grow slowly, and
+    widening by ``WIDEN`` alone ran one try per tree node, 100 to reach the window.
     ``primal_window`` 0 turns the narrow tries off. ``limit``: seconds per try;
     ``max_labels``, ``max_routes``: the caps beyond which a listing gives up;
     ``milp_routes``: cut rounds stop once this few routes are left; ``cuts_per_round``:
     triples per round."""
 
-    WIDEN = 0.1  # steps added to a narrow window that listed no better plan
+    WIDEN = 0.1  # steps added to a narrow window that listed no better plan, doubled each time
     STALL = 0.002  # cut rounds stop when a round lowers the LP by less than this many steps
     # the MILP is only tried over at most this many routes: over 60 827 (M = 20, K = 4 seed
     # 111) HiGHS ran 150 s past a 100 s time limit, and every proof so far came from < 12 000
@@ -88,6 +91,7 @@ class Enumeration:
         self.cuts_per_round = cuts_per_round
         self._tried = None  # (certificate, incumbent value) of the last try
         self._wider = None  # the next narrow window to try with them (None: nothing left)
+        self._step = self.WIDEN  # steps the narrow window widens by after its next try
         self._node_window = np.inf  # node tries only below this window (one at it was capped)
 
     def window(self) -> float | None:
@@ -113,7 +117,10 @@ class Enumeration:
         if window is None:
             return False
         cert = elim.cert
-        width = self.primal_window if self._tried != (cert, s.incumbent_value) else self._wider
+        if self._tried != (cert, s.incumbent_value):
+            width, self._step = self.primal_window, self.WIDEN
+        else:
+            width = self._wider
         complete = window <= max(self.gap, width)
         self._tried, self._wider = (cert, s.incumbent_value), None
         floor = elim.rc_floor()
@@ -126,7 +133,7 @@ class Enumeration:
         log.debug("root listing: window %.3f, width %s, %d labels, %s routes: %s", window,
                   "all" if complete else f"{width:.2f}", res.n_labels,
                   None if res.paths is None else len(res.paths), outcome)
-        growth = self._growth(width, res)[0] if res.paths is not None else np.inf
+        growth = self._growth(width, res, self.WIDEN)[0] if res.paths is not None else np.inf
         s.stats.enum_growth = round(growth, 3) if np.isfinite(growth) else None
         if outcome is None:
             return False
@@ -235,22 +242,27 @@ class Enumeration:
         return (status if status in ("infeasible", "optimal") else None), res
 
     def _widen(self, width: float, res: "Enumerated") -> None:
-        """After a narrow try that listed no better plan: the next, ``WIDEN`` steps wider, if
-        its labels and routes would stay within the caps, were they to grow as at the narrow
-        listing's rim (:meth:`_growth`)."""
-        labels, routes = self._growth(width, res)
-        if (res.n_labels * labels <= self.max_labels
-                and len(res.paths) * routes <= self.max_routes):
-            self._wider = width + self.WIDEN
+        """After a narrow try that listed no better plan: the next, ``_step`` steps wider (and
+        the step after it twice that), or half, a quarter, ... of it down to ``WIDEN``: the
+        widest whose labels and routes would stay within the caps, were they to grow as at the
+        narrow listing's rim (:meth:`_growth`)."""
+        step = self._step
+        while step >= self.WIDEN - 1e-9:
+            labels, routes = self._growth(width, res, step)
+            if (res.n_labels * labels <= self.max_labels
+                    and len(res.paths) * routes <= self.max_routes):
+                self._wider, self._step = width + step, 2 * step
+                return
+            step /= 2
 
     def _counted(self, width: float) -> float:
         """The steps at the rim of a ``width``-wide listing over which it counts its growth."""
         return min(self.WIDEN, width) if width > 0 else self.WIDEN
 
-    def _growth(self, width: float, res: "Enumerated") -> tuple[float, float]:
-        """Labels and routes: how many times more a listing ``WIDEN`` steps wider than ``res``
+    def _growth(self, width: float, res: "Enumerated", step: float) -> tuple[float, float]:
+        """Labels and routes: how many times more a listing ``step`` steps wider than ``res``
         (``width`` steps wide) would make, growing geometrically as over its rim."""
-        power = self.WIDEN / self._counted(width)
+        power = step / self._counted(width)
         return tuple(g ** power if g > 1 else 1.0 for g in res.growth())
 
     def _tighten(self, lp: EnumeratedLP, need: float, y: np.ndarray, deadline: float) -> bool:

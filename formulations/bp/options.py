@@ -152,9 +152,9 @@ class BPOptions:
       routes to list grows four- to sixfold per 0.1 step on M = 20, K = 5 (docs/bp.md).
     - ``enum_primal_window``: above ``enum_gap``, list only the routes within this many prize
       steps of the best and search them for a better plan (no proof); when they hold none,
-      try 0.1 steps wider while the listing would stay within the caps, were it to grow as
-      over the narrow one's last 0.1 steps (complete once as wide as the window); 0: no such
-      tries.
+      try wider (by 0.1 steps, then by up to twice the last widening) while the listing would stay
+      within the caps, were it to grow as over the narrow one's last 0.1 steps (complete once
+      as wide as the window); 0: no such tries.
     - ``enum_labels``, ``enum_routes``: a try gives up beyond this many labels or routes. The
       labels take about 70 bytes each, so 2^24 (16.8 M) stay near 1.2 GB, within the
       harness's 4 GB per worker; a try that still runs out of memory gives up as well.

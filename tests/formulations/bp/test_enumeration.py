@@ -62,7 +62,7 @@ def test_enumeration_out_of_memory_gives_up_the_try(monkeypatch, where):
 
 def test_narrow_tries_widen_until_complete(monkeypatch):
     """Above enum_gap a try lists only the routes within enum_primal_window steps of the best;
-    when they hold no better plan the next try is WIDEN steps wider, and one as wide as the
+    when they hold no better plan the next try is wider, and one as wide as the
     window is complete and proves the optimum (WIDEN made large, its growth guard aside: the
     second try is complete)."""
 
@@ -72,14 +72,17 @@ def test_narrow_tries_widen_until_complete(monkeypatch):
     inst = load_instance(TOP_DIR / "p2.2.k.txt")
     opts = BPOptions(enum_share=0.5, enum_gap=0.0, enum_primal_window=0.1)
     narrow = solve_bp(inst, time_limit=60, options=opts)
-    assert narrow.info["enum_tries"] >= 2 and narrow.info["enum_complete"] == 0  # 0.1 wider each
+    # 0.1, 0.2, 0.4, 0.8 steps wide, widening by twice the last widening, then as wide as the
+    # window: complete, and here a proof
+    assert narrow.info["enum_tries"] >= 3 and narrow.info["enum_complete"] == 1
+    assert narrow.status == Status.OPTIMAL
     # a wider listing that would pass the label cap, grown as over the narrow one's rim, is not
     # tried (its labels grow here, a little)
     capped = solve_bp(inst, time_limit=60, options=dataclasses.replace(
         opts, enum_labels=narrow.info["enum_labels"] + 1))
     assert capped.info["enum_tries"] == 1 and capped.status == Status.OPTIMAL
     monkeypatch.setattr(Enumeration, "WIDEN", 100.0)
-    monkeypatch.setattr(Enumeration, "_growth", lambda self, width, res: (1.0, 1.0))  # the guard aside
+    monkeypatch.setattr(Enumeration, "_growth", lambda self, width, res, step: (1.0, 1.0))  # the guard aside
     res = solve_bp(inst, time_limit=60, options=opts)
     assert (res.info["enum_tries"], res.info["enum_complete"]) == (2, 1)
     assert res.status == Status.OPTIMAL and res.info["enum_status"] == "infeasible"
@@ -87,9 +90,10 @@ def test_narrow_tries_widen_until_complete(monkeypatch):
 
 
 def test_widening_is_guarded_by_the_growth_at_the_rim():
-    """A narrow try that listed no better plan is widened by WIDEN steps only if its labels and
-    routes, times their growth over the listing's rim (extrapolated geometrically to WIDEN
-    steps when the listing is narrower), fit the caps."""
+    """A narrow try that listed no better plan is widened (by WIDEN steps, then twice the last
+    widening, or half of that ... down to WIDEN) only if its labels and routes, times their
+    growth over the listing's rim (extrapolated geometrically to the widening's steps), fit
+    the caps."""
     from sarcover.formulations.bp.enumeration import Enumeration
     from sarcover.formulations.bp.enumeration_kernel import Enumerated
 
@@ -108,6 +112,19 @@ def test_widening_is_guarded_by_the_growth_at_the_rim():
     assert widened(0.05, 16_000, 400) == pytest.approx(0.15)
     assert widened(0.05, 15_999, 400) is None and widened(0.05, 16_000, 399) is None
     assert Enumerated(None, 7).growth() == (np.inf, np.inf)
+    # the widenings double: 0.2 -> 0.3 -> 0.5 (the second over 0.2 steps: 16 times the labels)
+    e = Enumeration(None, None, None, limit=1.0, gap=0.3, max_labels=16_000, max_routes=400,
+                    primal_window=0.2)
+    e._widen(0.2, res)
+    assert e._wider == pytest.approx(0.3)
+    e._widen(0.3, res)
+    assert e._wider == pytest.approx(0.5)
+    e._wider = None
+    e._widen(0.5, res)  # 0.4 steps: 256 times the labels; 0.2 steps fit
+    assert e._wider == pytest.approx(0.7)
+    e._wider, e.max_labels = None, 3999
+    e._widen(0.7, res)  # not even 0.1 steps fit
+    assert e._wider is None
 
 
 @pytest.mark.parametrize("seed", range(7))
