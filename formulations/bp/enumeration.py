@@ -61,7 +61,7 @@ class Enumeration:
     the caps; a try as wide as the window is complete. The first widening adds ``WIDEN`` steps
     and each next one twice the last, or less (halved down to ``WIDEN``) where the caps call
     for it: at a window of ten steps (TOP's 100-point files) the listings grow slowly, and
-    widening by ``WIDEN`` alone ran one try per tree node, 100 to reach the window.
+    widening by ``WIDEN`` alone took one try per tree node and never reached the window.
     ``primal_window`` 0 turns the narrow tries off. ``limit``: seconds per try;
     ``max_labels``, ``max_routes``: the caps beyond which a listing gives up;
     ``milp_routes``: cut rounds stop once this few routes are left; ``cuts_per_round``:
