@@ -67,7 +67,7 @@ class Enumeration:
     ``milp_routes``: cut rounds stop once this few routes are left; ``cuts_per_round``:
     triples per round."""
 
-    WIDEN = 0.1  # steps added to a narrow window that listed no better plan, doubled each time
+    WIDEN = 0.1  # the first widening of a narrow window that listed no better plan (steps)
     STALL = 0.002  # cut rounds stop when a round lowers the LP by less than this many steps
     # the MILP is only tried over at most this many routes: over 60 827 (M = 20, K = 4 seed
     # 111) HiGHS ran 150 s past a 100 s time limit, and every proof so far came from < 12 000
