@@ -3,7 +3,10 @@
 The Chao-Golden-Wasil TOP files live in ``instances/top/`` beside this module, with their
 published values in ``optimal.csv`` (columns ``instance,value,status,source``; ``status`` is
 ``optimal`` for a proven value, ``best_known`` for the best published plan) and their
-provenance in ``PROVENANCE.md``. A benchmark name (``p2.3.g``) stands for its file wherever an
+provenance in ``PROVENANCE.md``. ``optimal.csv`` is kept as copied; where this project showed a
+copied value wrong for the file as written, ``corrections.csv`` beside it holds the value that
+replaces it, the copied one and the evidence (:func:`corrections`), and :func:`published` answers
+with the corrected value. A benchmark name (``p2.3.g``) stands for its file wherever an
 instance file is read: suites, ``sarcover solve`` and :func:`sarcover.read_instance`.
 """
 
@@ -49,19 +52,36 @@ def instance_path(name_or_path: str | Path) -> Path:
 _TABLES: dict[Path, dict[str, tuple[float, str]]] = {}
 
 
+def _read_values(table: Path) -> dict[str, tuple[float, str]]:
+    """instance -> (value, status) of a values table (rows it cannot read are skipped)."""
+    values = {}
+    if table.is_file():
+        with table.open() as fh:
+            for row in csv.DictReader(fh):
+                try:
+                    values[row["instance"]] = (float(row["value"]), row.get("status") or "optimal")
+                except (KeyError, TypeError, ValueError):
+                    continue
+    return values
+
+
 def published(path: str | Path) -> tuple[float, str] | None:
-    """(value, status) published for the file at ``path``, from the ``optimal.csv`` beside it."""
+    """(value, status) known for the file at ``path``: the ``optimal.csv`` beside it, with the
+    rows of ``corrections.csv`` (if any) in place of the copied ones."""
     path = Path(path)
     table = path.parent / "optimal.csv"
     if table not in _TABLES:
-        values = {}
-        if table.is_file():
-            with table.open() as fh:
-                for row in csv.DictReader(fh):
-                    try:
-                        values[row["instance"]] = (float(row["value"]), row.get("status") or "optimal")
-                    except (KeyError, TypeError, ValueError):
-                        continue
-        _TABLES[table] = values
+        _TABLES[table] = {**_read_values(table), **_read_values(path.parent / "corrections.csv")}
     return _TABLES[table].get(path.stem)
+
+
+def corrections(folder: str | Path = TOP_DIR) -> list[dict[str, str]]:
+    """The rows of ``corrections.csv`` in ``folder``: ``instance``, the ``value`` and ``status``
+    used here, the copied table's ``copied_value`` and ``copied_status``, and the ``evidence``
+    (empty without the file)."""
+    table = Path(folder) / "corrections.csv"
+    if not table.is_file():
+        return []
+    with table.open() as fh:
+        return list(csv.DictReader(fh))
 

@@ -14,7 +14,10 @@ published best known value, a lower bound on the optimum, where it is not). Per 
   the exact TOP literature reports most of sets 4-7 solved to optimality (``PROVENANCE.md``); the
   section counts these proofs apart from the news;
 - an unproven file gets its certified gap (bound − plan)/bound: the true gap of the plan is at
-  most that.
+  most that;
+- where ``corrections.csv`` (:func:`sarcover.benchmarks.catalog.corrections`) replaces a copied
+  value, every row of the file is checked against the corrected value, rows stored before the
+  correction included, and the section lists the correction with its evidence.
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from sarcover.benchmarks.catalog import corrections
 from sarcover.reports.gaps import TOL, instance_table
 
 SUITE = "top-4-7"
@@ -32,9 +36,22 @@ def _set_of(name: pd.Series) -> pd.Series:
     return name.str.extract(r"^p(\d+)\.", expand=False).astype(int)
 
 
-def file_table(df: pd.DataFrame, method: str = PROVER) -> pd.DataFrame:
-    """Per file: set, published values, bp's status, plan and bound, the checks and the gaps."""
-    rows = df[df["method"] == method]
+def corrected(df: pd.DataFrame, fixes: list[dict[str, str]] | None = None) -> pd.DataFrame:
+    """``df`` with each corrected file's ``reference`` and ``best_known`` set from its correction
+    (``fixes``: rows of ``corrections.csv``; None: the shipped ones)."""
+    out = df.copy()
+    for fix in corrections() if fixes is None else fixes:
+        at = out["instance"] == fix["instance"]
+        value = float(fix["value"])
+        out.loc[at, "reference"] = value if fix["status"] == "optimal" else np.nan
+        out.loc[at, "best_known"] = value if fix["status"] == "best_known" else np.nan
+    return out
+
+
+def file_table(df: pd.DataFrame, method: str = PROVER, fixes: list[dict[str, str]] | None = None) -> pd.DataFrame:
+    """Per file: set, published values (corrected where ``fixes`` say, see :func:`corrected`),
+    bp's status, plan and bound, the checks and the gaps."""
+    rows = corrected(df[df["method"] == method], fixes)
     inst = instance_table(rows)
     run = rows.drop_duplicates("instance").set_index("instance").reindex(inst.index)
     out = pd.DataFrame(index=inst.index)
@@ -135,12 +152,27 @@ def _proofs_of_best_known(files: pd.DataFrame) -> list[str]:
     return lines + [""]
 
 
-def top_sets_section(df: pd.DataFrame | None, out, *, heading: str = "##") -> list[str]:
-    """The section's Markdown lines; ``top_4_7_sets.csv`` and ``top_4_7_files.csv`` go into ``out``."""
+def _corrections(files: pd.DataFrame, fixes: list[dict[str, str]] | None) -> list[str]:
+    """The corrections to the copied table that concern these files, with their evidence."""
+    fixes = [f for f in (corrections() if fixes is None else fixes) if f["instance"] in files.index]
+    if not fixes:
+        return []
+    lines = ["Corrections to the copied table (`corrections.csv`; `optimal.csv` stays as copied): these files "
+             "are checked against the value below, not the copied one.", ""]
+    for f in fixes:
+        lines.append(f"- {f['instance']}: {float(f['value']):g} ({f['status']}) in place of the copied "
+                     f"{float(f['copied_value']):g} ({f['copied_status']}). {f['evidence']}")
+    return lines + [""]
+
+
+def top_sets_section(df: pd.DataFrame | None, out, *, heading: str = "##",
+                     fixes: list[dict[str, str]] | None = None) -> list[str]:
+    """The section's Markdown lines; ``top_4_7_sets.csv`` and ``top_4_7_files.csv`` go into ``out``.
+    ``fixes``: the corrections to apply (None: the shipped ``corrections.csv``)."""
     lines = [f"{heading} bp on the larger TOP sets (Chao, Golden & Wasil sets 4-7, suite `{SUITE}`)", ""]
     if df is None or not (df["method"] == PROVER).any():
         return lines + [f"No bp rows of `{SUITE}` yet.", ""]
-    files = file_table(df)
+    files = file_table(df, fixes=fixes)
     st = set_table(files)
     files.to_csv(out / "top_4_7_files.csv")
     st.to_csv(out / "top_4_7_sets.csv", index=False)
@@ -164,6 +196,7 @@ def top_sets_section(df: pd.DataFrame | None, out, *, heading: str = "##") -> li
     else:
         lines += ["News: none (no plan above a best known value of the shipped table).", ""]
     lines += _proofs_of_best_known(files)
+    lines += _corrections(files, fixes)
     missing = sorted(set(range(4, 8)) - set(st["set"]))
     if missing:
         lines += [f"Sets without rows yet: {', '.join(map(str, missing))}.", ""]

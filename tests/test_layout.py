@@ -182,6 +182,8 @@ def test_wheel_installs_only_the_sarcover_namespace(wheel):
     assert not [n for n in names if "/tests/" in n or "/docs/" in n or "bench_" in Path(n).name]
     assert "sarcover/benchmarks/suites/quick.toml" in names
     assert "sarcover/benchmarks/instances/top/p2.2.b.txt" in names
+    assert "sarcover/benchmarks/instances/top/corrections.csv" in names
+    assert "sarcover/benchmarks/instances/top/evidence/p4.4.n-977.json" in names
     assert "sarcover/formulations/bp/master.py" in names
 
 
