@@ -29,6 +29,7 @@ import time
 from typing import TYPE_CHECKING
 
 import numpy as np
+from sarcover.formulations.bp.audit import audit_listing
 from sarcover.formulations.bp.enumerated_lp import EnumeratedLP
 from sarcover.formulations.bp.enumeration_kernel import Enumerated, enumerate_routes
 from sarcover.formulations.bp.graph import NodeState, node_graph
@@ -65,7 +66,8 @@ class Enumeration:
     ``primal_window`` 0 turns the narrow tries off. ``limit``: seconds per try;
     ``max_labels``, ``max_routes``: the caps beyond which a listing gives up;
     ``milp_routes``: cut rounds stop once this few routes are left; ``cuts_per_round``:
-    triples per round."""
+    triples per round; ``audit``: check a proof by a complete listing apart from the kernels
+    (:mod:`.audit`)."""
 
     WIDEN = 0.1  # the first widening of a narrow window that listed no better plan (steps)
     STALL = 0.002  # cut rounds stop when a round lowers the LP by less than this many steps
@@ -78,7 +80,7 @@ class Enumeration:
     def __init__(self, search: "Search", elimination: "Elimination",
                  incumbents: "IncumbentSearch", *, limit: float, gap: float, max_labels: int,
                  max_routes: int, primal_window: float = 0.0, milp_routes: int = 5000,
-                 cuts_per_round: int = 50):
+                 cuts_per_round: int = 50, audit: bool = False):
         self.search = search
         self.elimination = elimination
         self.incumbents = incumbents
@@ -89,6 +91,7 @@ class Enumeration:
         self.max_routes = max_routes
         self.milp_routes = milp_routes
         self.cuts_per_round = cuts_per_round
+        self.audit = audit
         self._tried = None  # (certificate, incumbent value) of the last try
         self._wider = None  # the next narrow window to try with them (None: nothing left)
         self._step = self.WIDEN  # steps the narrow window widens by after its next try
@@ -141,7 +144,27 @@ class Enumeration:
             if outcome == "infeasible":  # no better plan among the listed routes
                 self._widen(width, res)
             return False
+        if outcome == "infeasible" and self.audit:
+            self._audit(res, cert, floor)
         return outcome in ("infeasible", "optimal")
+
+    def _audit(self, res: "Enumerated", cert, floor: float) -> None:
+        """Check the proof just made by a complete root listing apart from the kernels that made
+        it (:func:`.audit.audit_listing`) and report the outcome in the run's stats."""
+        s, m = self.search, self.search.master
+        y = cert.duals
+        sig = np.zeros(len(m.cuts))
+        sig[:] = np.maximum(y[m.base_rows :], 0.0)[: len(m.cuts)]
+        prizes = np.zeros(s.problem.V + 2)
+        prizes[1 : s.problem.V + 1] = m.prizes
+        need = s.need()
+        found = audit_listing(res.paths, s.problem.cost, s.problem.budget, m.point_profit(y),
+                              y[0] + floor, (m.cut_members, m.cut_memory, sig), prizes=prizes,
+                              vehicles=s.problem.N, need=need,
+                              floor=need - cert.dual_term + s.problem.N * y[0],
+                              reduced=res.values)
+        s.stats.audit = found.summary()
+        log.info("audit of the root listing's proof: %s", s.stats.audit)
 
     def node_window(self, dual_term: float) -> float | None:
         """The window of a node below the root whose LP value is ``dual_term`` (steps above

@@ -163,12 +163,14 @@ class Enumerated(NamedTuple):
     points without start and end, padded with -1 (None when a cap or the deadline stopped the
     search), and the labels made; of those, the labels whose bounds also clear the threshold
     plus the ``margin`` and the routes whose best ordering does (``inner_routes``, exact: the
-    routes a listing at that threshold would give)."""
+    routes a listing at that threshold would give); ``values``: each listed set's best prize
+    (after the cuts' duals) over the orders its labels reached, row for row with ``paths``."""
 
     paths: np.ndarray | None
     n_labels: int
     inner_labels: int = 0
     inner_routes: int = 0
+    values: np.ndarray | None = None
 
     def growth(self) -> tuple[float, float]:
         """Labels and routes of this listing over those ``margin`` further in: how many times
@@ -251,4 +253,4 @@ def enumerate_routes(cost, profit, allowed, budget, threshold, *, ng=None, cut_m
     paths = np.full((done.size, len(levels)), -1, np.int32)
     for k, (live, pts) in enumerate(levels):  # the k-th point from the end of each route
         paths[live, length[live] - 1 - k] = pts
-    return Enumerated(paths, *counts)
+    return Enumerated(paths, *counts, values=best[np.argsort(first)])

@@ -158,6 +158,12 @@ class BPOptions:
     - ``enum_labels``, ``enum_routes``: a try gives up beyond this many labels or routes. The
       labels take about 70 bytes each, so 2^24 (16.8 M) stay near 1.2 GB, within the
       harness's 4 GB per worker; a try that still runs out of memory gives up as well.
+    - ``audit_listings``: when a complete root listing proves the incumbent optimal, check the
+      proof by other means than the ones it used (:mod:`.audit`: every route one insertion,
+      removal or swap from a listed one that should be listed is; no set of at most N disjoint
+      listed routes is worth incumbent + step, searched exhaustively under the certificate) and
+      report it in ``info`` (``audit_*``). Off by default: it takes minutes at 100 points and
+      does not change the run's outcome, only what it reports.
       ``enum_labels`` None: by the time limit (:func:`default_enum_labels`).
     """
 
@@ -206,6 +212,8 @@ class BPOptions:
     enum_labels: int | None = _opt(None, "an enumeration try gives up beyond this many labels; none: 2^24 "
                                          "from 300 s, less below", 1)
     enum_routes: int = _opt(3_000_000, "an enumeration try gives up beyond this many routes", 1)
+    audit_listings: bool = _opt(False, "audit a proof by a complete root listing apart from the enumeration's "
+                                       "kernels (closure and packing checks; slow: minutes at 100 points)")
 
     @classmethod
     def for_time_limit(cls, time_limit: float | None) -> "BPOptions":

@@ -74,7 +74,8 @@ class BranchAndPrice:
         self.enumeration = (Enumeration(s, self.elimination, self.incumbents,
                                         limit=share(opts.enum_share), gap=opts.enum_gap,
                                         max_labels=opts.enum_labels, max_routes=opts.enum_routes,
-                                        primal_window=opts.enum_primal_window)
+                                        primal_window=opts.enum_primal_window,
+                                        audit=opts.audit_listings)
                             if opts.enum_share > 0 else None)
         self.colgen = ColumnGeneration(s, self.pricer, self.elimination, ng_cap=opts.ng_cap,
                                        grow_until=s.clock.until(opts.grow_share))
