@@ -247,6 +247,7 @@ def _cmd_solve(args) -> int:
     from sarcover.benchmarks.catalog import instance_path
     from sarcover.benchmarks.params import parse_assignment
     from sarcover.benchmarks.registry import check_size, get_method, run_method
+    from sarcover.benchmarks.rows import clean
     from sarcover.formulations.io import load_instance
     from sarcover.formulations.records import outcome
 
@@ -268,7 +269,7 @@ def _cmd_solve(args) -> int:
     if plan_out is not None:
         _write_plan(instance, run, plan_out)
     if args.json:
-        _print(json.dumps(record))
+        _print(json.dumps(clean(record)))  # numpy scalars in a method's info, too
     else:
         _print(_summary(instance, spec, record))
     if plot is not None:  # on stderr, so that stdout stays one JSON object with --json

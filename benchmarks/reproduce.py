@@ -137,6 +137,7 @@ def _main(argv: list[str] | None, prog: str) -> int:
 
     from sarcover.benchmarks.harness import run_suite
     from sarcover.benchmarks.suite import load_suite
+    from sarcover.benchmarks.catalog import corrections
     from sarcover.reports.reference import write_reference
 
     root = Path(args.results)
@@ -166,7 +167,8 @@ def _main(argv: list[str] | None, prog: str) -> int:
     notes = ([f"paper-n and paper-k ran with {args.runs} random instances per setting."] if not args.report_only
              else []) + args.note
     path = write_reference(root, args.out, suites=SUITES,
-                           command=f"python -m sarcover.benchmarks.reproduce --runs {args.runs}", notes=notes)
+                           command=f"python -m sarcover.benchmarks.reproduce --runs {args.runs}", notes=notes,
+                           fixes=corrections())
     print(f"wrote {path}", file=sys.stderr)
     return 0
 

@@ -123,9 +123,11 @@ def _significance(paired: pd.DataFrame) -> pd.DataFrame:
 
 
 def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
-                    command: str = "python -m sarcover.benchmarks.reproduce", notes: list[str] | None = None) -> Path:
+                    command: str = "python -m sarcover.benchmarks.reproduce", notes: list[str] | None = None,
+                    fixes: list[dict[str, str]] | None = None) -> Path:
     """Write ``out/README.md`` (with its PNGs and CSVs) from the suites' result directories under
-    ``root``; ``suites`` names them in run order (the run-log table)."""
+    ``root``; ``suites`` names them in run order (the run-log table); ``fixes``: the corrections
+    to the copied TOP table (:func:`.top_sets.top_sets_section`)."""
     root, out = Path(root), Path(out)
     out.mkdir(parents=True, exist_ok=True)
     pn, pk, peers = _load(root, "paper-n"), _load(root, "paper-k"), _load(root, "paper-peers")
@@ -312,7 +314,7 @@ def write_reference(root: str | Path, out: str | Path, *, suites: list[str],
         L += [write_convergence(anytime, [opt] if opt is not None else [], out)]
     L += _top_section(top, out)
     if top47 is not None:
-        L += top_sets_section(top47, out)
+        L += top_sets_section(top47, out, fixes=fixes)
     # -- E_max
     if em is not None:
         g = em.groupby(["method", "e_max"])

@@ -15,8 +15,9 @@ published best known value, a lower bound on the optimum, where it is not). Per 
   section counts these proofs apart from the news;
 - an unproven file gets its certified gap (bound − plan)/bound: the true gap of the plan is at
   most that;
-- where ``corrections.csv`` (:func:`sarcover.benchmarks.catalog.corrections`) replaces a copied
-  value, every row of the file is checked against the corrected value, rows stored before the
+- where a correction to the copied table replaces a copied value (``fixes``: the rows of
+  ``corrections.csv``, which the caller reads with :func:`sarcover.benchmarks.catalog.corrections`),
+  every row of the file is checked against the corrected value, rows stored before the
   correction included, and the section lists the correction with its evidence.
 """
 
@@ -25,7 +26,6 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from sarcover.benchmarks.catalog import corrections
 from sarcover.reports.gaps import TOL, instance_table
 
 SUITE = "top-4-7"
@@ -38,9 +38,9 @@ def _set_of(name: pd.Series) -> pd.Series:
 
 def corrected(df: pd.DataFrame, fixes: list[dict[str, str]] | None = None) -> pd.DataFrame:
     """``df`` with each corrected file's ``reference`` and ``best_known`` set from its correction
-    (``fixes``: rows of ``corrections.csv``; None: the shipped ones)."""
+    (``fixes``: rows of ``corrections.csv``; None: none)."""
     out = df.copy()
-    for fix in corrections() if fixes is None else fixes:
+    for fix in fixes or []:
         at = out["instance"] == fix["instance"]
         value = float(fix["value"])
         out.loc[at, "reference"] = value if fix["status"] == "optimal" else np.nan
@@ -154,7 +154,7 @@ def _proofs_of_best_known(files: pd.DataFrame) -> list[str]:
 
 def _corrections(files: pd.DataFrame, fixes: list[dict[str, str]] | None) -> list[str]:
     """The corrections to the copied table that concern these files, with their evidence."""
-    fixes = [f for f in (corrections() if fixes is None else fixes) if f["instance"] in files.index]
+    fixes = [f for f in fixes or [] if f["instance"] in files.index]
     if not fixes:
         return []
     lines = ["Corrections to the copied table (`corrections.csv`; `optimal.csv` stays as copied): these files "
@@ -168,7 +168,7 @@ def _corrections(files: pd.DataFrame, fixes: list[dict[str, str]] | None) -> lis
 def top_sets_section(df: pd.DataFrame | None, out, *, heading: str = "##",
                      fixes: list[dict[str, str]] | None = None) -> list[str]:
     """The section's Markdown lines; ``top_4_7_sets.csv`` and ``top_4_7_files.csv`` go into ``out``.
-    ``fixes``: the corrections to apply (None: the shipped ``corrections.csv``)."""
+    ``fixes``: the corrections to the copied table to apply (rows of ``corrections.csv``)."""
     lines = [f"{heading} bp on the larger TOP sets (Chao, Golden & Wasil sets 4-7, suite `{SUITE}`)", ""]
     if df is None or not (df["method"] == PROVER).any():
         return lines + [f"No bp rows of `{SUITE}` yet.", ""]

@@ -5,9 +5,11 @@ plus one step) is made of listed routes. That rests on two things this module ch
 means than the ones the proof used (``audit_listings`` of :class:`.options.BPOptions`):
 
 * **closure** (:func:`missing_neighbours`): every route one insertion, one removal or one swap
-  away from a listed route, within the budget on the true distances (eliminated arcs back) and
-  of reduced prize above the listing's threshold (its own order's limited-memory cut pays), is
-  itself listed. The completion and suffix bounds and the dominance that the listing shares with
+  away from a listed route, within the budget on the listing's graph and of reduced prize above
+  the listing's threshold (its own order's limited-memory cut pays), is itself listed. (The
+  graph is the listing's because an arc eliminated under an earlier certificate is in no plan
+  better than the incumbent even where a route through it clears this threshold: the arc
+  elimination is not audited here.) The completion and suffix bounds and the dominance that the listing shares with
   the pricing could only drop a route silently; a dropped route next to a listed one shows here.
 * **packing** (:func:`packing_reaches`): an exhaustive search over every set of at most N
   pairwise disjoint listed routes for one worth ``need``, pruned only by the certificate: such a
@@ -27,6 +29,7 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+from sarcover.formulations.bp._label_store import out_of_time
 
 
 @njit(cache=True)
@@ -170,10 +173,11 @@ def missing_neighbours(paths, dist, budget, profit, threshold, cuts) -> tuple[in
 
 
 @njit(cache=True)
-def _pack(masks, red, val, vehicles, floor, need, max_steps):
+def _pack(masks, red, val, vehicles, floor, need, deadline):
     """Iterative depth-first search over sets of pairwise disjoint routes (routes by ``red``
     descending) with reduced prizes summing to >= ``floor`` and values to >= ``need``; returns
-    (found route indices padded with -1, steps, finished)."""
+    (route indices padded with -1, outcome): 1 found (the indices), 0 none exists, -1 the
+    ``deadline`` (a :func:`time.perf_counter` moment) came first."""
     k, words = masks.shape
     pick = np.full(vehicles, -1, np.int64)
     acc = np.zeros((vehicles + 1, words), np.uint64)
@@ -185,15 +189,15 @@ def _pack(masks, red, val, vehicles, floor, need, max_steps):
     while True:
         # the routes after nxt add at most (slots left) x red[nxt], or red[nxt] if negative
         if nxt >= k or max((vehicles - d) * red[nxt], red[nxt]) < floor - rsum[d]:
-            if d == 0:  # this depth is exhausted: back up
-                return pick, steps, True
+            if d == 0:  # every set was examined
+                return pick, 0
             d -= 1
             nxt = pick[d] + 1
             pick[d] = -1
             continue
         steps += 1
-        if steps > max_steps:
-            return pick, steps, False
+        if (steps & 0xFFFFF) == 0 and out_of_time(deadline):
+            return pick, -1
         i = nxt
         nxt += 1
         clash = False
@@ -209,7 +213,7 @@ def _pack(masks, red, val, vehicles, floor, need, max_steps):
         rsum[d + 1] = rsum[d] + red[i]
         vsum[d + 1] = vsum[d] + val[i]
         if rsum[d + 1] >= floor and vsum[d + 1] >= need:
-            return pick, steps, True
+            return pick, 1
         if d + 1 < vehicles:
             d += 1
             nxt = i + 1
@@ -218,10 +222,10 @@ def _pack(masks, red, val, vehicles, floor, need, max_steps):
 
 
 def packing_reaches(paths, value, reduced, vehicles: int, need: float, floor: float,
-                    max_steps: int = 2_000_000_000) -> tuple[list[int] | None, bool]:
+                    max_seconds: float = 3600.0) -> tuple[list[int] | None, bool]:
     """(routes, finished): row indices of at most ``vehicles`` pairwise disjoint routes of
     ``paths`` whose ``value`` sums to >= ``need`` and whose ``reduced`` prizes sum to >=
-    ``floor`` (None when there is none), and whether the search finished within ``max_steps``
+    ``floor`` (None when there is none), and whether the search finished within ``max_seconds``
     (unfinished: None says nothing)."""
     n = int(paths.max()) + 1 if paths.size else 1
     words = (n + 63) // 64
@@ -229,11 +233,12 @@ def packing_reaches(paths, value, reduced, vehicles: int, need: float, floor: fl
     for r, row in enumerate(paths):
         masks[r] = _mask(row[row >= 0].astype(np.int64), int((row >= 0).sum()), words)
     order = np.argsort(-np.asarray(reduced, dtype=float), kind="stable")
-    pick, _, finished = _pack(masks[order], np.asarray(reduced, dtype=float)[order] + 1e-6,
-                              np.asarray(value, dtype=float)[order], int(vehicles), float(floor),
-                              float(need) - 1e-6, int(max_steps))
-    found = [int(order[i]) for i in pick if i >= 0]
-    return (found or None) if finished or found else None, finished
+    pick, outcome = _pack(masks[order], np.asarray(reduced, dtype=float)[order] + 1e-6,
+                          np.asarray(value, dtype=float)[order], int(vehicles), float(floor),
+                          float(need) - 1e-6, time.perf_counter() + float(max_seconds))
+    if outcome == 1:
+        return [int(order[i]) for i in pick if i >= 0], True
+    return None, outcome == 0
 
 
 class Audit(NamedTuple):
@@ -259,11 +264,11 @@ class Audit(NamedTuple):
 
 
 def audit_listing(paths, dist, budget, profit, threshold, cuts, *, prizes, vehicles: int,
-                  need: float, floor: float, reduced=None, max_steps: int = 2_000_000_000) -> Audit:
+                  need: float, floor: float, reduced=None, max_seconds: float = 3600.0) -> Audit:
     """Both checks of the module on one complete listing (``paths``), threshold ``threshold`` in
-    reduced prize: the closure on the true distances ``dist``, then the packing of routes worth
+    reduced prize: the closure on the arc costs ``dist`` (inf: no arc), then the packing of routes worth
     ``need`` (``prizes``: per solver point) whose reduced prizes reach ``floor`` (need - D +
-    N·y0). ``reduced``: each listed set's best reduced prize over its orders (the kernel's,
+    N·y0), for at most ``max_seconds``. ``reduced``: each listed set's best reduced prize over its orders (the kernel's,
     :attr:`.enumeration_kernel.Enumerated.values`); None: its points' ``profit`` with no cut
     paid, an upper bound for any order (safe, but the search prunes less)."""
     t = time.perf_counter()
@@ -271,5 +276,5 @@ def audit_listing(paths, dist, budget, profit, threshold, cuts, *, prizes, vehic
     if reduced is None:
         reduced = [float(profit[row[row >= 0]].sum()) for row in paths]
     value = [float(prizes[row[row >= 0]].sum()) for row in paths]
-    packing, finished = packing_reaches(paths, value, reduced, vehicles, need, floor, max_steps)
-    return Audit(missing, tested, packing, finished, time.perf_counter() - t)
+    packing, finished = packing_reaches(paths, value, reduced, vehicles, need, floor, max_seconds)
+    return Audit(int(missing), int(tested), packing, finished, time.perf_counter() - t)

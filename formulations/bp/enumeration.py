@@ -158,7 +158,10 @@ class Enumeration:
         prizes = np.zeros(s.problem.V + 2)
         prizes[1 : s.problem.V + 1] = m.prizes
         need = s.need()
-        found = audit_listing(res.paths, s.problem.cost, s.problem.budget, m.point_profit(y),
+        # the listing's graph: an arc eliminated under an earlier certificate is no arc of a
+        # plan better than the incumbent, even where a route through it clears this threshold
+        cost, _, _ = node_graph(s, NodeState())
+        found = audit_listing(res.paths, cost, s.problem.budget, m.point_profit(y),
                               y[0] + floor, (m.cut_members, m.cut_memory, sig), prizes=prizes,
                               vehicles=s.problem.N, need=need,
                               floor=need - cert.dual_term + s.problem.N * y[0],

@@ -44,6 +44,17 @@ def test_solve_json_stdout_is_one_object_for_exact_methods(tmp_path, method):
     assert ("compiling numba code" in out.stderr) == (method == "bp")
 
 
+def test_solve_json_carries_bp_info_with_an_audited_proof():
+    """`solve --json` on a bp run that proves by a root listing and audits it: its info (numpy
+    counters included) comes out as one JSON object, the audit in it."""
+    out = run("solve", "p2.2.k", "--method", "bp", "--json", "--time-limit", "60", "--param", "enum_share=0.5",
+              "--param", "enum_gap=1.0", "--param", "audit_listings=true")
+    assert out.returncode == 0, out.stderr
+    rec = json.loads(out.stdout)
+    assert rec["status"] == "optimal" and rec["info"]["enum_status"] == "infeasible"
+    assert rec["info"]["audit"]["audit_passed"] is True
+
+
 def test_solve_top_file_summary():
     """A TOP benchmark file solves; the readable summary names method and objective."""
     out = run("solve", str(TOP_DIR / "p2.2.k.txt"))

@@ -109,3 +109,13 @@ def test_the_audit_flags_a_listing_that_dropped_routes(monkeypatch):
     res = solve_bp(inst, time_limit=60, options=BPOptions(enum_share=0.5, enum_gap=1.0, audit_listings=True))
     audit = res.info["audit"]
     assert audit is not None and audit["audit_missing"] >= 1 and not audit["audit_passed"]
+
+
+def test_a_packing_search_stopped_by_its_time_says_so():
+    """Many small disjoint routes and a floor no set reaches: stopped at once, the search is
+    unfinished and claims no packing; given the time, it finishes and finds none."""
+    n_routes = 400
+    paths = np.arange(1, n_routes + 1, dtype=np.int64).reshape(-1, 1)
+    value, reduced = np.ones(n_routes), np.ones(n_routes)
+    assert packing_reaches(paths, value, reduced, 4, need=10.0, floor=0.0, max_seconds=0.0) == (None, False)
+    assert packing_reaches(paths, value, reduced, 4, need=10.0, floor=0.0, max_seconds=600.0) == (None, True)
