@@ -214,7 +214,22 @@ def _pack(masks, red, val, vehicles, floor, need, deadline):
         vsum[d + 1] = vsum[d] + val[i]
         if rsum[d + 1] >= floor and vsum[d + 1] >= need:
             return pick, 1
-        if d + 1 < vehicles:
+        if d + 2 == vehicles:  # the last route: one tight scan (where most of the time goes)
+            rest = floor - rsum[d + 1]
+            for q in range(i + 1, k):
+                if red[q] < rest:
+                    break
+                clash = False
+                for w in range(words):
+                    if acc[d + 1, w] & masks[q, w]:
+                        clash = True
+                        break
+                if not clash and vsum[d + 1] + val[q] >= need:
+                    pick[d + 1] = q
+                    return pick, 1
+            steps += 1
+            pick[d] = -1
+        elif d + 1 < vehicles:
             d += 1
             nxt = i + 1
         else:
