@@ -52,16 +52,22 @@ def instance_path(name_or_path: str | Path) -> Path:
 _TABLES: dict[Path, dict[str, tuple[float, str]]] = {}
 
 
+def _rows(table: Path) -> list[dict[str, str]]:
+    """The rows of a CSV table (none without the file)."""
+    if not table.is_file():
+        return []
+    with table.open() as fh:
+        return list(csv.DictReader(fh))
+
+
 def _read_values(table: Path) -> dict[str, tuple[float, str]]:
     """instance -> (value, status) of a values table (rows it cannot read are skipped)."""
     values = {}
-    if table.is_file():
-        with table.open() as fh:
-            for row in csv.DictReader(fh):
-                try:
-                    values[row["instance"]] = (float(row["value"]), row.get("status") or "optimal")
-                except (KeyError, TypeError, ValueError):
-                    continue
+    for row in _rows(table):
+        try:
+            values[row["instance"]] = (float(row["value"]), row.get("status") or "optimal")
+        except (KeyError, TypeError, ValueError):
+            continue
     return values
 
 
@@ -79,9 +85,5 @@ def corrections(folder: str | Path = TOP_DIR) -> list[dict[str, str]]:
     """The rows of ``corrections.csv`` in ``folder``: ``instance``, the ``value`` and ``status``
     used here, the copied table's ``copied_value`` and ``copied_status``, and the ``evidence``
     (empty without the file)."""
-    table = Path(folder) / "corrections.csv"
-    if not table.is_file():
-        return []
-    with table.open() as fh:
-        return list(csv.DictReader(fh))
+    return _rows(Path(folder) / "corrections.csv")
 

@@ -9,8 +9,9 @@ means than the ones the proof used (``audit_listings`` of :class:`.options.BPOpt
   the listing's threshold (its own order's limited-memory cut pays), is itself listed. (The
   graph is the listing's because an arc eliminated under an earlier certificate is in no plan
   better than the incumbent even where a route through it clears this threshold: the arc
-  elimination is not audited here.) The completion and suffix bounds and the dominance that the listing shares with
-  the pricing could only drop a route silently; a dropped route next to a listed one shows here.
+  elimination is not audited here.) The completion and suffix bounds and the dominance that
+  the listing shares with the pricing could only drop a route silently; a dropped route next
+  to a listed one shows here.
 * **packing** (:func:`packing_reaches`): an exhaustive search over every set of at most N
   pairwise disjoint listed routes for one worth ``need``, pruned only by the certificate: such a
   plan's routes have reduced prizes summing to at least need - (D - N·y0) (D the certificate's
@@ -147,14 +148,19 @@ def _closure(paths, dist, budget, profit, cmem, mmem, sig, threshold, keys):
     return counts[0], counts[1]
 
 
-def _keys(paths: np.ndarray, n: int) -> np.ndarray:
-    """The listed routes' point sets as rows of 64-bit words, sorted lexicographically."""
+def _masks(paths: np.ndarray, n: int) -> np.ndarray:
+    """The point sets of ``paths`` (points below ``n``) as rows of 64-bit words."""
     words = (n + 63) // 64
-    keys = np.zeros((len(paths), words), np.uint64)
+    masks = np.zeros((len(paths), words), np.uint64)
     for r, row in enumerate(paths):
-        keys[r] = _mask(row[row >= 0].astype(np.int64), int((row >= 0).sum()), words)
-    order = np.lexsort(keys.T[::-1])
-    return np.ascontiguousarray(keys[order])
+        masks[r] = _mask(row[row >= 0].astype(np.int64), int((row >= 0).sum()), words)
+    return masks
+
+
+def _keys(paths: np.ndarray, n: int) -> np.ndarray:
+    """The listed routes' point sets (:func:`_masks`), sorted lexicographically."""
+    keys = _masks(paths, n)
+    return np.ascontiguousarray(keys[np.lexsort(keys.T[::-1])])
 
 
 def missing_neighbours(paths, dist, budget, profit, threshold, cuts) -> tuple[int, int]:
@@ -242,11 +248,7 @@ def packing_reaches(paths, value, reduced, vehicles: int, need: float, floor: fl
     ``paths`` whose ``value`` sums to >= ``need`` and whose ``reduced`` prizes sum to >=
     ``floor`` (None when there is none), and whether the search finished within ``max_seconds``
     (unfinished: None says nothing)."""
-    n = int(paths.max()) + 1 if paths.size else 1
-    words = (n + 63) // 64
-    masks = np.zeros((len(paths), words), np.uint64)
-    for r, row in enumerate(paths):
-        masks[r] = _mask(row[row >= 0].astype(np.int64), int((row >= 0).sum()), words)
+    masks = _masks(paths, int(paths.max()) + 1 if paths.size else 1)
     order = np.argsort(-np.asarray(reduced, dtype=float), kind="stable")
     pick, outcome = _pack(masks[order], np.asarray(reduced, dtype=float)[order] + 1e-6,
                           np.asarray(value, dtype=float)[order], int(vehicles), float(floor),
@@ -279,17 +281,14 @@ class Audit(NamedTuple):
 
 
 def audit_listing(paths, dist, budget, profit, threshold, cuts, *, prizes, vehicles: int,
-                  need: float, floor: float, reduced=None, max_seconds: float = 3600.0) -> Audit:
+                  need: float, floor: float, reduced, max_seconds: float = 3600.0) -> Audit:
     """Both checks of the module on one complete listing (``paths``), threshold ``threshold`` in
-    reduced prize: the closure on the arc costs ``dist`` (inf: no arc), then the packing of routes worth
-    ``need`` (``prizes``: per solver point) whose reduced prizes reach ``floor`` (need - D +
-    N·y0), for at most ``max_seconds``. ``reduced``: each listed set's best reduced prize over its orders (the kernel's,
-    :attr:`.enumeration_kernel.Enumerated.values`); None: its points' ``profit`` with no cut
-    paid, an upper bound for any order (safe, but the search prunes less)."""
+    reduced prize: the closure on the arc costs ``dist`` (inf: no arc), then the packing of
+    routes worth ``need`` (``prizes``: per solver point) whose reduced prizes reach ``floor``
+    (need - D + N·y0), for at most ``max_seconds``. ``reduced``: each listed set's best reduced
+    prize over its orders (the kernel's, :attr:`.enumeration_kernel.Enumerated.values`)."""
     t = time.perf_counter()
     missing, tested = missing_neighbours(paths, dist, budget, profit, threshold, cuts)
-    if reduced is None:
-        reduced = [float(profit[row[row >= 0]].sum()) for row in paths]
     value = [float(prizes[row[row >= 0]].sum()) for row in paths]
     packing, finished = packing_reaches(paths, value, reduced, vehicles, need, floor, max_seconds)
     return Audit(int(missing), int(tested), packing, finished, time.perf_counter() - t)

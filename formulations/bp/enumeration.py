@@ -154,7 +154,8 @@ class Enumeration:
         s, m = self.search, self.search.master
         y = cert.duals
         sig = np.zeros(len(m.cuts))
-        sig[:] = np.maximum(y[m.base_rows :], 0.0)[: len(m.cuts)]
+        cut = m.cut_duals(y)[: len(m.cuts)]
+        sig[: cut.size] = cut
         prizes = np.zeros(s.problem.V + 2)
         prizes[1 : s.problem.V + 1] = m.prizes
         need = s.need()
@@ -214,7 +215,7 @@ class Enumeration:
         t = time.perf_counter()
         cost, _, allowed = node_graph(s, state)
         sig = np.zeros(len(m.cuts))
-        cut = np.maximum(y[m.base_rows :], 0.0)[: len(m.cuts)]
+        cut = m.cut_duals(y)[: len(m.cuts)]
         sig[: cut.size] = cut
         st.enum_tries += 1
         try:
