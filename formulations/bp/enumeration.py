@@ -25,6 +25,7 @@ point's row is ``= 1`` in the LP and the MILP over them).
 from __future__ import annotations
 
 import logging
+import math
 import time
 from typing import TYPE_CHECKING
 
@@ -53,17 +54,19 @@ class Enumeration:
     The window (certificate bound - incumbent - one step) decides how: up to ``gap`` steps the
     listing is complete and its outcome a proof (no better plan, or the MILP's plan is
     optimal); above it, only the routes within ``primal_window`` steps of the best are listed
-    (the threshold raised by the difference), and the MILP over them can only find a better
-    plan. The plan one step above the incumbent has a total slack of the window over its
-    routes, so most of its routes sit well inside a narrow window. A narrow try that finds no
-    plan is followed by a wider one (with the same certificate and incumbent) if its labels and
+    (the threshold raised by the difference), and the MILP over them can find a better plan
+    and cap the bound (:meth:`_cap`), a proof only where that cap meets the incumbent. The
+    plan one step above the incumbent has a total slack of the window over its routes, so most
+    of its routes sit well inside a narrow window. A narrow try that finds no plan is followed
+    at once by a wider one (with the same certificate and incumbent) if its labels and
     routes, times their growth at the narrow listing's rim (over its last ``WIDEN`` steps, or
     all of it if narrower, extrapolated geometrically: :meth:`Enumerated.growth`), stay within
     the caps; a try as wide as the window is complete. The first widening adds ``WIDEN`` steps
     and each next one twice the last, or less (halved down to ``WIDEN``) where the caps call
     for it: at a window of ten steps (TOP's 100-point files) the listings grow slowly, and
     widening by ``WIDEN`` alone took one try per tree node and never reached the window.
-    ``primal_window`` 0 turns the narrow tries off. ``limit``: seconds per try;
+    ``primal_window`` 0 turns the narrow tries off. ``limit``: seconds per call of
+    :meth:`close` (its tries together);
     ``max_labels``, ``max_routes``: the caps beyond which a listing gives up;
     ``milp_routes``: cut rounds stop once this few routes are left; ``cuts_per_round``:
     triples per round; ``audit``: check a proof by a complete listing apart from the kernels
@@ -113,8 +116,19 @@ class Enumeration:
         return window
 
     def close(self) -> bool:
-        """One try; True when it proved the incumbent (possibly a new one, the MILP's) optimal.
-        """
+        """Tries under the current certificate and incumbent, a narrow one that listed no
+        better plan widened at once (all within ``limit`` seconds); True when one proved the
+        incumbent (possibly a new one, the MILP's) optimal. The tries are cheap next to a tree
+        node on TOP's two-vehicle files (seconds against a minute), where one try per node
+        reached the window's width only after the run's limit."""
+        until = time.perf_counter() + self.limit
+        while True:
+            proved = self._try(until)
+            if proved or self._wider is None or time.perf_counter() >= until:
+                return proved
+
+    def _try(self, until: float) -> bool:
+        """One try (deadline ``until`` at the latest); whether it proved the incumbent optimal."""
         s, elim = self.search, self.elimination
         window = self.window()
         if window is None:
@@ -127,9 +141,11 @@ class Enumeration:
         complete = window <= max(self.gap, width)
         self._tried, self._wider = (cert, s.incumbent_value), None
         floor = elim.rc_floor()
+        # the least a plan may be worth to have all its routes listed
+        reach = s.need() + (0.0 if complete else (window - width) * s.problem.step)
         if not complete:  # only the routes within ``width`` steps of the best
             floor += (window - width) * s.problem.step
-        deadline = min(s.clock.deadline, time.perf_counter() + self.limit)
+        deadline = min(s.clock.deadline, until)
         outcome, res = self._decide(cert.duals, floor, NodeState(), deadline, self.max_labels,
                                     self._counted(width) * s.problem.step)
         s.stats.enum_complete += complete
@@ -141,12 +157,29 @@ class Enumeration:
         if outcome is None:
             return False
         if not complete:
+            self._cap(reach)
             if outcome == "infeasible":  # no better plan among the listed routes
                 self._widen(width, res)
-            return False
+            return s.incumbent_value >= s.cap - 1e-6
         if outcome == "infeasible" and self.audit:
             self._audit(res, cert, floor)
         return outcome in ("infeasible", "optimal")
+
+    def _cap(self, reach: float) -> None:
+        """After a narrow try that decided (no plan better than the incumbent among its
+        routes, or the best such plan, now the incumbent): the listing held every route of the
+        plans worth at least ``reach`` (its floor is that of such a plan), so none of them beats
+        the incumbent, and no plan is worth more than the incumbent or the lattice point below
+        ``reach``, whichever is higher (:meth:`.search.Search.lower_cap`). A cap at the
+        incumbent proves it; above, it lowers the reported bound. At windows of several steps
+        (TOP's two-vehicle files) a narrow try that listed no better plan showed the bound one
+        or more steps too high, and nothing used that."""
+        s, step = self.search, self.search.problem.step
+        if s.problem.integral:  # the lowest lattice point at or above reach (1e-6 to spare)
+            below = step * math.ceil((reach - 1e-7) / step) - step
+        else:
+            below = reach
+        s.lower_cap(max(s.incumbent_value, below))
 
     def _audit(self, res: "Enumerated", cert, floor: float) -> None:
         """Check the proof just made by a complete root listing apart from the kernels that made

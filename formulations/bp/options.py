@@ -144,8 +144,9 @@ class BPOptions:
     Route enumeration (:mod:`.enumeration`), tried after the root once its certificate leaves
     the incumbent one step from a proof:
 
-    - ``enum_share``: seconds for one try (listing the routes, the LP over them with its cuts,
-      the MILP over the routes left), as a share of the limit (30 s without one); 0 turns
+    - ``enum_share``: seconds for the tries under one certificate and incumbent (each:
+      listing the routes, the LP over them with its cuts, the MILP over the routes left; a
+      narrow try that listed no better plan is widened at once), as a share of the limit (30 s without one); 0 turns
       enumeration off. None: 0.6 from ``ENUM_FROM_S`` (60 s), else 0.
     - ``enum_gap``: the listing is complete (its outcome a proof) while the root certificate's
       bound is at most this many prize steps above the incumbent + one step; the number of
@@ -203,8 +204,9 @@ class BPOptions:
     elim_share: float = _opt(0.1, "time for the labelling arc bounds (arc elimination), as a share of the "
                                   "limit", 0, 1)
     pool_routes: int = _opt(2000, "best elementary routes of the arc-bound labelling that join the master", 0)
-    enum_share: float | None = _opt(None, "time of one route enumeration try as a share of the limit (0: "
-                                          "enumeration off); none: 0.6 from 60 s, else 0", 0, 1)
+    enum_share: float | None = _opt(None, "time of the root's route enumeration tries (widened at once) "
+                                          "as a share of the limit (0: enumeration off); none: 0.6 "
+                                          "from 60 s, else 0", 0, 1)
     enum_gap: float = _opt(0.3, "enumeration is complete (a proof) while the root bound is at most this many "
                                 "prize steps above incumbent + 1", 0)
     enum_primal_window: float = _opt(0.2, "above enum_gap, list routes within this many prize steps of the "

@@ -34,10 +34,14 @@ class Search:
         # the incumbent (solver points); without groups the empty plan is one
         self.incumbent_value = 0.0 if not instance.groups else -math.inf
         self.incumbent: list[tuple[int, ...]] | None = [] if not instance.groups else None
+        # no plan is worth more than this: a narrow route listing showed it
+        # (:meth:`.enumeration.Enumeration.close`); it caps every node's bound
+        self.cap = math.inf
 
     def prunable(self, bound: float) -> bool:
-        """No plan better than the incumbent lies under a node of this bound."""
-        b = self.problem.floor(bound)
+        """No plan better than the incumbent lies under a node of this bound (or above the
+        run's cap)."""
+        b = self.problem.floor(min(bound, self.cap))
         if self.incumbent is None:
             return b < -TOL  # no plan (prize >= 0) exists below this node
         return b <= self.incumbent_value + TOL
@@ -47,9 +51,18 @@ class Search:
         integer prizes, anything above it otherwise."""
         return self.incumbent_value + (self.problem.step if self.problem.integral else 1e-9)
 
+    def lower_cap(self, value: float) -> None:
+        """No plan is worth more than ``value`` (the proof is the caller's)."""
+        if value < self.cap:
+            self.cap = value
+            self.stats.cap = value
+            self.log(value)
+
     def log(self, bound: float | None = None) -> None:
         """One point of the history: (seconds since the start, incumbent, bound)."""
         inc = None if self.incumbent is None else self.incumbent_value
+        if bound is not None:
+            bound = min(bound, self.cap)
         if bound is not None and inc is not None:
             bound = max(bound, inc)  # after arc elimination a bound only covers better plans
         self.stats.history.append((round(time.perf_counter() - self.clock.t0, 4), inc, bound))

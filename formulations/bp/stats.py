@@ -55,6 +55,7 @@ class Stats:
     enum_left: int | None = None  # routes left after its reduced-cost filter
     enum_milp_s: float = 0.0  # the MILP over the enumerated routes
     enum_status: str | None = None  # its outcome: optimal, infeasible (proof) or open
+    cap: float | None = None  # no plan is worth more: shown by a narrow listing (None: none did)
     audit: dict | None = None  # the audit of the proof by a root listing (audit_listings)
     node_enum_tries: int = 0  # of the tries, complete listings at nodes below the root
     node_enum_closed: int = 0  # nodes they closed
@@ -93,7 +94,7 @@ class Stats:
             "enum_lp_s": round(self.enum_lp_s, 3), "enum_lp_bound": self.enum_lp_bound,
             "enum_cuts": self.enum_cuts, "enum_left": self.enum_left,
             "enum_milp_s": round(self.enum_milp_s, 3), "enum_status": self.enum_status,
-            "audit": self.audit,
+            "cap": self.cap, "audit": self.audit,
             "node_enum_tries": self.node_enum_tries, "node_enum_closed": self.node_enum_closed,
             "root_lp": self.root_lp, "primal_calls": self.primal_calls,
             "primal_s": self.primal_s, "primal_prize": self.primal_prize,

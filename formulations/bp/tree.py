@@ -10,8 +10,9 @@ certificate (:mod:`.enumeration`) is tried when the certificate or the incumbent
 node whose LP value comes within the enumeration's window of the incumbent is converged fully
 and its routes listed under its own duals, which can close it without branching
 (:meth:`BranchAndPrice._solve_node`).
-The reported bound is max(incumbent, floored bounds of the open nodes), certified at every stop;
-a run whose open nodes all floor to the incumbent is proven.
+The reported bound is max(incumbent, floored bounds of the open nodes), each capped by what a
+narrow route listing showed no plan exceeds (:attr:`.search.Search.cap`), certified at every
+stop; a run whose open nodes all floor to the incumbent, or whose cap is the incumbent, is proven.
 """
 
 from __future__ import annotations
@@ -215,6 +216,7 @@ class BranchAndPrice:
         inc = s.incumbent_value if s.incumbent is not None else -math.inf
         if not open_bounds:
             return finished, inc
-        open_bound = max(s.problem.floor(b) for b in open_bounds)
-        proven = s.incumbent is not None and not unresolved and open_bound <= inc + TOL
+        open_bound = max(s.problem.floor(min(b, s.cap)) for b in open_bounds)
+        proven = s.incumbent is not None and (
+            s.cap <= inc + TOL or (not unresolved and open_bound <= inc + TOL))
         return proven, max(inc, open_bound)

@@ -192,3 +192,62 @@ def test_node_listings_close_nodes_and_keep_the_optimum(monkeypatch):
         assert verify(inst, res.plan).prize == pytest.approx(verify(inst, ref.plan).prize)
         closed += res.info["node_enum_closed"]
     assert closed >= 1
+
+
+def test_the_cap_rounds_up_to_the_lattice_below_the_listed_plans():
+    """A narrow try that decided lists every route of the plans worth at least ``reach``: the
+    cap is the lattice point below ``reach`` (``reach`` itself on it: nothing of that value
+    beats the incumbent), never below the incumbent; on TOP set 3's lattice of 10 too."""
+    from sarcover.formulations.bp.tree import BranchAndPrice
+
+    from bp_cases import random_tiny
+
+    bp = BranchAndPrice(random_tiny(0, groups=False), time_limit=30,
+                        options=BPOptions(enum_share=0.5))
+    s = bp.search
+    assert s.problem.integral and s.problem.step == 1.0 and s.cap == np.inf
+    s.incumbent_value = 1093.0
+    for reach, cap in [(1096.2, 1096.0), (1095.0005, 1095.0), (1095.0, 1094.0),
+                       (1094.79, 1094.0), (1094.5, 1094.0), (1093.2, 1093.0)]:
+        bp.enumeration._cap(reach)
+        assert s.cap == cap and s.stats.cap == cap  # lowered, never raised
+    s.problem.step, s.cap = 10.0, np.inf
+    s.incumbent_value = 500.0
+    bp.enumeration._cap(523.0)
+    assert s.cap == 520.0
+    bp.enumeration._cap(505.0)  # the incumbent is the least it can be
+    assert s.cap == 500.0 and s.prunable(10_000.0)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_narrow_tries_cap_the_bound_without_passing_the_optimum(seed):
+    """Under duals of 0 (a route's reduced prize is its prize, rc* the best route's) narrow tries
+    from the empty plan list the routes within the window of the best one. After each, the cap
+    is at least the brute-force optimum, and a try that says it proved the incumbent holds it
+    (the cap at the incumbent, or a complete listing)."""
+    from sarcover.formulations.bp.compile import warm_up
+    from sarcover.formulations.bp.elimination import Certificate
+    from sarcover.formulations.bp.graph import NodeState
+    from sarcover.formulations.bp.tree import BranchAndPrice
+
+    from bp_cases import brute_force, feasible_routes, random_tiny
+
+    warm_up()  # compiling is not charged to the listings' deadlines
+    inst = random_tiny(seed, groups=False)
+    best = brute_force(inst)
+    rc_star = max(float(inst.prizes[list(r)].sum()) for r in feasible_routes(inst))
+    bp = BranchAndPrice(inst, time_limit=30, options=BPOptions(
+        enum_share=0.5, enum_gap=0.0, enum_primal_window=0.5))
+    s, m = bp.search, bp.search.master
+    m.apply(NodeState())
+    N = inst.n_vehicles
+    bp.elimination.cert = Certificate(np.zeros(m.n_rows), 0.0, rc_star, N * rc_star)
+    proved, caps = False, []
+    while not proved and bp.enumeration.window() is not None:
+        proved = bp.enumeration.close()
+        caps.append(s.cap)
+        assert s.cap >= best - 1e-9
+    assert proved and s.incumbent_value == best
+    assert caps == sorted(caps, reverse=True)
+    if s.stats.enum_complete == 0:  # proven by the cap alone
+        assert s.cap == best
