@@ -146,8 +146,9 @@ class BPOptions:
 
     - ``enum_share``: seconds for the tries under one certificate and incumbent (each:
       listing the routes, the LP over them with its cuts, the MILP over the routes left; a
-      narrow try that listed no better plan is widened at once), as a share of the limit (30 s without one); 0 turns
-      enumeration off. None: 0.6 from ``ENUM_FROM_S`` (60 s), else 0.
+      narrow try that listed no better plan is widened at once), as a share of the limit
+      (30 s without one); 0 turns enumeration off. None: 0.6 from ``ENUM_FROM_S`` (60 s),
+      else 0.
     - ``enum_gap``: the listing is complete (its outcome a proof) while the root certificate's
       bound is at most this many prize steps above the incumbent + one step; the number of
       routes to list grows four- to sixfold per 0.1 step on M = 20, K = 5 (docs/bp.md).
