@@ -121,7 +121,7 @@ class Enumeration:
         incumbent (possibly a new one, the MILP's) optimal. The tries are cheap next to a tree
         node on TOP's two-vehicle files (seconds against a minute), where one try per node
         reached the window's width only after the run's limit."""
-        until = time.perf_counter() + self.limit
+        until = min(time.perf_counter() + self.limit, self.search.clock.deadline)
         while True:
             proved = self._try(until)
             if proved or self._wider is None or time.perf_counter() >= until:
@@ -145,8 +145,7 @@ class Enumeration:
         reach = s.need() + (0.0 if complete else (window - width) * s.problem.step)
         if not complete:  # only the routes within ``width`` steps of the best
             floor += (window - width) * s.problem.step
-        deadline = min(s.clock.deadline, until)
-        outcome, res = self._decide(cert.duals, floor, NodeState(), deadline, self.max_labels,
+        outcome, res = self._decide(cert.duals, floor, NodeState(), until, self.max_labels,
                                     self._counted(width) * s.problem.step)
         s.stats.enum_complete += complete
         log.debug("root listing: window %.3f, width %s, %d labels, %s routes: %s", window,
@@ -186,9 +185,7 @@ class Enumeration:
         it (:func:`.audit.audit_listing`) and report the outcome in the run's stats."""
         s, m = self.search, self.search.master
         y = cert.duals
-        sig = np.zeros(len(m.cuts))
-        cut = m.cut_duals(y)[: len(m.cuts)]
-        sig[: cut.size] = cut
+        sig = self._cut_duals(y)
         prizes = np.zeros(s.problem.V + 2)
         prizes[1 : s.problem.V + 1] = m.prizes
         need = s.need()
@@ -247,9 +244,7 @@ class Enumeration:
         s, m, st = self.search, self.search.master, self.search.stats
         t = time.perf_counter()
         cost, _, allowed = node_graph(s, state)
-        sig = np.zeros(len(m.cuts))
-        cut = m.cut_duals(y)[: len(m.cuts)]
-        sig[: cut.size] = cut
+        sig = self._cut_duals(y)
         st.enum_tries += 1
         try:
             res = enumerate_routes(cost, m.point_profit(y), allowed, s.problem.budget, y[0] + floor,
@@ -300,6 +295,15 @@ class Enumeration:
             if s.incumbent_value < value - 1e-6:
                 return None, res
         return (status if status in ("infeasible", "optimal") else None), res
+
+    def _cut_duals(self, y: np.ndarray) -> np.ndarray:
+        """The master's current cuts' duals in ``y`` (:meth:`.master.Master.cut_duals`),
+        0 for a cut added after ``y`` was solved (a certificate from before it)."""
+        m = self.search.master
+        sig = np.zeros(len(m.cuts))
+        cut = m.cut_duals(y)[: len(m.cuts)]
+        sig[: cut.size] = cut
+        return sig
 
     def _widen(self, width: float, res: "Enumerated") -> None:
         """After a narrow try that listed no better plan: the next, ``_step`` steps wider (and
