@@ -25,7 +25,7 @@ paper-opt         1.8 h     the paper's grid (Fig. 3 and 4 settings, 20 instance
 decomposition     ~12 min   clustering / cross-cluster / routing loss of the paper methods, from
                             paper-opt's optima, at N=5 K=3, N=5 K=6 and K=3 N=2..6 (one instance per
                             worker; 755 of its 960 rows took 9.3 min on 2)
-top-4-7           2.1 h     bp alone at 600 s on the 192 shipped files of TOP sets 4-7 (4.3 CPU-hours)
+top-4-7           2.0 h     bp alone at 600 s on the 192 shipped files of TOP sets 4-7 (4.1 CPU-hours)
 paper-validation  2.3 h     bp alone on the paper grid with paper-opt's limits, 20 held-out instances per
                             setting (seeds 200..219, which chose no setting): its proof rates beside
                             paper-opt's, which are tuning figures (about paper-opt's bp part)
