@@ -2,7 +2,9 @@
 
 Each round solves the restricted master LP and prices:
 
-1. heuristic pricing (dominance without remembered sets) until it finds no improving route;
+1. heuristic pricing until it finds no improving route: at the root, from ``route_search_from``
+   points on and without cuts, local search from the LP's routes (:mod:`.route_search`) first,
+   then the labelling with dominance without remembered sets;
 2. exact pricing over ng-routes (a relaxation of elementary routes): its best reduced prize gives
    the certified Lagrangian bound of the round. Improving routes become columns, elementary or
    not: an ng-route that repeats a point enters the master with visit-count coefficients, so it
@@ -65,16 +67,19 @@ class RootSteps(Protocol):
 
 class ColumnGeneration:
     """Solves nodes' LPs for one run (:meth:`solve`); ng sets grow up to ``ng_cap`` points until
-    ``grow_until`` (a :func:`time.perf_counter` moment). ``root``: the root's steps (set once
+    ``grow_until`` (a :func:`time.perf_counter` moment); from ``route_search_from`` points on
+    (0: never) a root round without cuts first seeks improving routes by local search
+    (:meth:`.pricer.Pricer.route_search`). ``root``: the root's steps (set once
     the root's policy exists)."""
 
     def __init__(self, search: "Search", pricer: "Pricer", elimination: "Elimination", *,
-                 ng_cap: int, grow_until: float):
+                 ng_cap: int, grow_until: float, route_search_from: int = 0):
         self.search = search
         self.pricer = pricer
         self.elimination = elimination
         self.ng_cap = ng_cap
         self.grow_until = grow_until
+        self.route_search_from = route_search_from
         self.root: RootSteps | None = None
         # (duals, rc*) of the node's last exact pricing: every route's reduced prize under the
         # duals is at most rc* (route enumeration at nodes lists under them)
@@ -113,6 +118,12 @@ class ColumnGeneration:
                 # With the triangle inequality a node of reduced prize <= 0 can be skipped.
                 allowed &= prof > 1e-12
             y0 = float(y[0])
+            if (root is not None and not m.cuts and s.problem.V >= self.route_search_from > 0):
+                added = m.add_routes(pricer.route_search(x, y, cost, prof, allowed, y0=y0))
+                if added:
+                    s.stats.route_search_columns += added
+                    root.slow_to_settle()
+                    continue  # the labelling only once the local search finds nothing
             res = pricer.heuristic(cost, ret, prof, allowed, y0=y0, sig=sig)
             bound = self._relaxed_bound(y, res, bound, root is not None)
             if s.prunable(bound):

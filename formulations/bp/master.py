@@ -118,7 +118,8 @@ def spread(triples, room: int, per_point: int = 3) -> list:
 
 
 class Master:
-    def __init__(self, n_nodes: int, prizes: np.ndarray, groups, n_vehicles: int):
+    def __init__(self, n_nodes: int, prizes: np.ndarray, groups, n_vehicles: int, *,
+                 primal_simplex: bool = False):
         self.V = n_nodes
         self.G = len(groups)
         self.N = n_vehicles
@@ -132,6 +133,10 @@ class Master:
         self.row_lo = np.concatenate([[-INF], np.full(self.V, -INF), np.ones(self.G)])
         self.row_hi = np.concatenate([[float(n_vehicles)], np.ones(self.V), np.full(self.G, INF)])
         h = quiet_highs()
+        if primal_simplex:
+            # new columns leave the last basis primal feasible: at hundreds of points HiGHS's
+            # primal simplex re-solves the restricted LP in half the dual simplex's time
+            h.setOptionValue("simplex_strategy", 4)
         h.changeObjectiveSense(highspy.ObjSense.kMaximize)
         h.addRows(self.n_rows, self.row_lo, self.row_hi, 0, np.zeros(self.n_rows, np.int32),
                   np.zeros(0, np.int32), np.zeros(0))

@@ -90,6 +90,12 @@ class BPOptions:
       (:func:`.graph.sparse_graph`); its routes are routes of the full graph, and the exact
       pricing and every bound stay on the full graph. 0 arcs: never.
     - ``heuristic_columns``: the most routes one heuristic pricing call returns.
+    - ``route_search_from``: from this many points on, each root round without cuts first
+      looks for improving routes by local search from the LP's routes
+      (:mod:`.route_search`), and only calls the labelling when that finds none; 0: never.
+    - ``primal_simplex_from``: from this many points on, the route master's LPs run HiGHS's
+      primal simplex (columns added to a solved LP leave its basis primal feasible; at 360
+      points it halved the LP's time); below, HiGHS's default; 0: never.
     - ``ng_cap``: the most points an ng set grows to when LP routes repeat a point.
     - ``exact_labels``: an exact pricing call gives up beyond this many labels (memory: about
       100 bytes each). Such a call certifies no bound: at the root the last cut round is
@@ -179,6 +185,10 @@ class BPOptions:
                                 "cheapest arcs (0: full graph)", 0)
     sparse_from: int = _opt(150, "points from which heuristic pricing runs on the sparse graph", 0)
     heuristic_columns: int = _opt(30, "most routes one heuristic pricing call returns", 1)
+    primal_simplex_from: int = _opt(150, "from this many points on, the master LPs run HiGHS's primal simplex "
+                                         "(0: never)", 0)
+    route_search_from: int = _opt(150, "from this many points on, root rounds without cuts first seek improving "
+                                     "routes by local search from the LP's routes (0: never)", 0)
     ng_cap: int = _opt(12, "most points an ng set grows to", 1)
     exact_labels: int = _opt(2_000_000, "an exact pricing call gives up beyond this many labels (about 100 "
                                         "bytes each)", 1)

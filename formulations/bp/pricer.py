@@ -7,10 +7,13 @@ from __future__ import annotations
 import time
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from sarcover.formulations.bp.constants import TOL
 from sarcover.formulations.bp.bounds import relaxed_best, suffix_tables
 from sarcover.formulations.bp.graph import cheapest_return, sparse_graph
 from sarcover.formulations.bp.labelling import price, sub_buckets
+from sarcover.formulations.bp.route_search import improving_routes
 
 if TYPE_CHECKING:
     from sarcover.formulations.bp.search import Search
@@ -18,6 +21,7 @@ if TYPE_CHECKING:
 
 HEURISTIC_LABELS = 200_000  # labels a heuristic call may make at first (see Pricer.heuristic)
 ROOT_LABEL_GROWTH = 4  # at the root the exact calls' label cap may grow to this multiple
+ROUTE_SEARCH_COLUMNS = 150  # most routes one local search pricing call returns
 
 
 class Pricer:
@@ -88,6 +92,26 @@ class Pricer:
                 return res
             self.heuristic_labels = min(4 * self.heuristic_labels, self.exact_labels)
             self.search.stats.heuristic_labels = self.heuristic_labels
+
+    def route_search(self, x, y, cost, prof, allowed, *, y0: float) -> list:
+        """Improving routes by local search (:mod:`.route_search`) from the LP solution's
+        routes and the columns of highest reduced prize under duals ``y`` (as many as the
+        vehicles), up to ``ROUTE_SEARCH_COLUMNS`` of them. Only without subset-row cuts, whose
+        duals it does not pay."""
+        s = self.search
+        m = s.master
+        t = time.perf_counter()
+        rc = m.reduced_costs(y)
+        picked = [int(r) for r in np.flatnonzero(x > TOL)]
+        picked += [int(r) for r in np.argsort(-rc)[: s.problem.N]]
+        starts = [m.routes[r] for r in dict.fromkeys(picked)
+                  if r not in m.dead and len(set(m.routes[r])) == len(m.routes[r])]
+        routes = improving_routes(starts, cost, prof, allowed, s.problem.budget, y0 + TOL,
+                                  ROUTE_SEARCH_COLUMNS)
+        dt = time.perf_counter() - t
+        s.stats.pricing_s += dt
+        s.stats.route_search_s += dt
+        return routes
 
     def raise_exact_cap(self) -> bool:
         """Double the exact calls' label cap, up to ``ROOT_LABEL_GROWTH`` times the option's

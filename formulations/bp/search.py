@@ -27,7 +27,8 @@ class Search:
         self.clock = Clock(time_limit)
         self.problem = p = Problem(instance)
         self.options = options
-        self.master = Master(p.V, instance.prizes, instance.groups, p.N)
+        self.master = Master(p.V, instance.prizes, instance.groups, p.N,
+                             primal_simplex=0 < options.primal_simplex_from <= p.V)
         size = options.ng_size
         self.ng = full_ng(p.V + 2) if size >= p.V else nearest_ng(p.cost, size)
         self.stats = Stats()

@@ -61,6 +61,8 @@ class Stats:
     node_enum_closed: int = 0  # nodes they closed
     root_lp: float | None = None  # restricted root LP value when cuts were first considered
     pricing_s: float = 0.0
+    route_search_s: float = 0.0  # the local search pricing (part of pricing_s)
+    route_search_columns: int = 0  # columns it added
     lp_s: float = 0.0
     root_bound: float | None = None
     root_s: float | None = None
@@ -99,7 +101,9 @@ class Stats:
             "root_lp": self.root_lp, "primal_calls": self.primal_calls,
             "primal_s": self.primal_s, "primal_prize": self.primal_prize,
             "primal_improved": self.primal_improved, "primal_error": self.primal_error,
-            "pricing_s": round(self.pricing_s, 3), "lp_s": round(self.lp_s, 3),
+            "pricing_s": round(self.pricing_s, 3),
+            "route_search_s": round(self.route_search_s, 3),
+            "route_search_columns": self.route_search_columns, "lp_s": round(self.lp_s, 3),
             "root_bound": self.root_bound, "root_s": self.root_s, "history": self.history,
             "threads": 1, "bidirectional": bidirectional, "mode_times": self.mode_times,
             "options": options,

@@ -79,7 +79,8 @@ class BranchAndPrice:
                                         audit=opts.audit_listings)
                             if opts.enum_share > 0 else None)
         self.colgen = ColumnGeneration(s, self.pricer, self.elimination, ng_cap=opts.ng_cap,
-                                       grow_until=s.clock.until(opts.grow_share))
+                                       grow_until=s.clock.until(opts.grow_share),
+                                       route_search_from=opts.route_search_from)
         self.root = Root(s, self.colgen, self.elimination, self.incumbents, self.cuts)
         self.colgen.root = self.root
         # starting columns: every reachable point alone, and the warm start's routes

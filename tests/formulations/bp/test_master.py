@@ -206,3 +206,28 @@ def test_removed_cuts_leave_the_lp_whatever_their_dual():
     assert [int(b) for b in m.cut_members[1:7]] == [0, 0, 0, 1, 1, 1]
     assert m.solve()[0] == pytest.approx(6.0)  # the triangle at 1/2 each again
     assert m.remove_cuts([]) == 0 and m.cuts == [(4, 5, 6)]
+
+
+def test_primal_simplex_master_solves_the_same_lp():
+    """The route master with HiGHS's primal simplex (``primal_simplex_from``) gives the same LP
+    value as with the default simplex, after columns are added to a solved LP."""
+    from sarcover.formulations.bp.master import Master
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
+
+    inst = to_top(generate(6, 3, 2, 5))
+    rng = np.random.default_rng(0)
+    batches = [[tuple(int(p) for p in rng.choice(np.arange(1, inst.n_nodes + 1), 4, replace=False))
+                for _ in range(15)] for _ in range(3)]
+    values = {}
+    for primal in (False, True):
+        m = Master(inst.n_nodes, inst.prizes, inst.groups, inst.n_vehicles, primal_simplex=primal)
+        got = []
+        for batch in batches:
+            m.add_routes(batch)
+            got.append(m.solve()[0])
+        values[primal] = got
+        strategy = m.h.getOptionValue("simplex_strategy")
+        strategy = strategy[1] if isinstance(strategy, tuple) else strategy  # (status, value)
+        assert strategy == (4 if primal else 1)
+    assert values[True] == pytest.approx(values[False])
