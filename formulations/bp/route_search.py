@@ -14,8 +14,9 @@ again. Every route passed on the way that beats the threshold is a candidate col
 step raises the prize or, at equal prize, lowers the energy, so the search ends.
 
 The routes are elementary and priced exactly (the points' reduced prizes, as the labelling
-sums them, against the vehicle dual); the subset-row cuts' duals are not paid here, so the caller only uses it while the master has no
-cuts. It proves nothing: when it finds no improving route the labelling runs as before.
+sums them, against the vehicle dual); the subset-row cuts' duals are not paid here, so the
+caller only uses it while the master has no cuts. It proves nothing: when it finds no
+improving route the labelling runs as before.
 """
 
 from __future__ import annotations
