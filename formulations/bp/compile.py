@@ -14,20 +14,21 @@ import sarcover.formulations.bp.cut_duals as cut_duals
 import sarcover.formulations.bp.enumerated_lp as enumerated_lp
 import sarcover.formulations.bp.enumeration_kernel as enumeration_kernel
 import sarcover.formulations.bp.labelling as labelling
+import sarcover.formulations.bp.route_search as route_search
 from sarcover.formulations.bp.graph import cheapest_return
 from sarcover.formulations.bp.ng_sets import full_ng
 
 # every module that holds numba kernels: warm_up compiles each kernel a run can call
 KERNEL_MODULES = (_label_store, cut_duals, bounds, labelling, arc_bounds, enumeration_kernel,
-                  enumerated_lp)
+                  enumerated_lp, route_search)
 
 _WARM = False
 
 
 def warm_up() -> None:
     """Compile every kernel once per process, on a three-point graph: the labelling in each mode
-    (heuristic or exact, one-way or bidirectional), both arc bounds, the route enumeration and
-    the enumerated LP's cut coefficients."""
+    (heuristic or exact, one-way or bidirectional), both arc bounds, the route enumeration,
+    the enumerated LP's cut coefficients and the local search pricing."""
     global _WARM
     if _WARM:
         return
@@ -44,4 +45,5 @@ def warm_up() -> None:
     enumeration_kernel.enumerate_routes(cost, prof, allowed, 4.0, -1.0)
     enumerated_lp.cut_coefficients(np.array([[1, 2, -1]], np.int32), np.ones((1, 4), np.bool_),
                                     np.ones((1, 4), np.bool_))
+    route_search.improving_routes([(1,)], cost, prof, allowed, 4.0, -1.0, 1)
     _WARM = True
