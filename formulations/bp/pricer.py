@@ -104,8 +104,8 @@ class Pricer:
         rc = m.reduced_costs(y)
         picked = [int(r) for r in np.flatnonzero(x > TOL)]
         picked += [int(r) for r in np.argsort(-rc)[: s.problem.N]]
-        starts = [m.routes[r] for r in dict.fromkeys(picked)
-                  if r not in m.dead and len(set(m.routes[r])) == len(m.routes[r])]
+        repeated = set(m.repeated)  # the local search starts from elementary routes only
+        starts = [m.routes[r] for r in dict.fromkeys(picked) if r not in repeated]
         routes = improving_routes(starts, cost, prof, allowed, s.problem.budget, y0 + TOL,
                                   ROUTE_SEARCH_COLUMNS)
         dt = time.perf_counter() - t

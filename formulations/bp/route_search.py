@@ -89,22 +89,22 @@ def _best_reversal(route, n, cost, energy, end):
     best_i, best_j, best_e = -1, -1, energy - 1e-7
     for i in range(n - 1):
         a = route[i - 1] if i > 0 else 0
+        inner = 0.0  # what reversing the arcs inside route[i..j] changes, grown with j
         for j in range(i + 1, n):
             b = route[j + 1] if j + 1 < n else end
+            inner += cost[route[j], route[j - 1]] - cost[route[j - 1], route[j]]
             # arcs a -> route[i] ... route[j] -> b become a -> route[j] ... route[i] -> b
             e = energy - cost[a, route[i]] - cost[route[j], b] + cost[a, route[j]] + \
-                cost[route[i], b]
-            for k in range(i, j):
-                e += cost[route[k + 1], route[k]] - cost[route[k], route[k + 1]]
+                cost[route[i], b] + inner
             if e < best_e:
                 best_i, best_j, best_e = i, j, e
     return best_i, best_j, best_e
 
 
 @njit(cache=True)
-def _search(start, n0, cost, prof, allowed, budget, min_gain, max_moves, out, out_len, out_val,
+def _search(start, cost, prof, allowed, budget, min_gain, max_moves, out, out_len, out_val,
             n_out):
-    """Local search from one route (``start[:n0]``); writes every route passed whose reduced
+    """Local search from one route (``start``); writes every route passed whose reduced
     prize beats ``min_gain`` into ``out`` from row ``n_out`` on and returns the new row
     count."""
     V2 = prof.shape[0]
@@ -112,7 +112,7 @@ def _search(start, n0, cost, prof, allowed, budget, min_gain, max_moves, out, ou
     cap = out.shape[1]
     route = np.zeros(cap, dtype=np.int64)
     inroute = np.zeros(V2, dtype=np.bool_)
-    n = n0
+    n = start.shape[0]
     for i in range(n):
         route[i] = start[i]
         inroute[start[i]] = True
@@ -168,19 +168,18 @@ def improving_routes(starts, cost: np.ndarray, prof: np.ndarray, allowed: np.nda
         return []
     longest = max(len(r) for r in starts)
     cap = longest + max_moves
-    rows = len(starts) * min(max_moves, 50)
+    per_start = min(max_moves, 50)  # routes kept from one start
+    rows = len(starts) * per_start
     out = np.zeros((rows, cap), dtype=np.int64)
     out_len = np.zeros(rows, dtype=np.int64)
     out_val = np.zeros(rows)
     prof = np.asarray(prof, dtype=np.float64)
     allowed = np.asarray(allowed, dtype=np.bool_)
     n_out = 0
-    per_start = min(max_moves, 50)
     for r in starts:
-        start = np.asarray(r, dtype=np.int64)
-        limit = min(rows, n_out + per_start)
-        n_out = _search(start, len(start), cost, prof, allowed, budget, min_gain, max_moves,
-                        out[:limit], out_len[:limit], out_val[:limit], n_out)
+        limit = n_out + per_start
+        n_out = _search(np.asarray(r, dtype=np.int64), cost, prof, allowed, budget, min_gain,
+                        max_moves, out[:limit], out_len[:limit], out_val[:limit], n_out)
     found: dict[tuple[int, ...], float] = {}
     for k in np.argsort(-out_val[:n_out], kind="stable"):
         route = tuple(int(p) for p in out[k, : out_len[k]])
