@@ -242,6 +242,8 @@ class PyVRPParams:
     history_length: int = param(300, "late-acceptance history length", minimum=1)
     neighbours: int = param(50, "granular neighbourhood size (nearest clients per client)", minimum=1)
     exhaustive_on_best: bool = param(True, "exhaustive local search on each new best solution")
+    pass1_share: float = param(0.6, "share of the time limit the first pass (with cover copies) may take",
+                               minimum=0.01, maximum=1.0)
 
 
 @takes(PyVRPParams)
@@ -256,7 +258,8 @@ def pyvrp(instance, *, seed=0, time_limit=DEFAULT_TIME_LIMIT, **params) -> Resul
         ils=IteratedLocalSearchParams(num_iters_no_improvement=p.no_improvement, history_length=p.history_length,
                                       exhaustive_on_best=p.exhaustive_on_best),
         neighbourhood=NeighbourhoodParams(num_neighbours=p.neighbours))
-    return pyvrp(instance, seed=seed, time_limit=time_limit, iterations=p.iterations, solve_params=solve_params)
+    return pyvrp(instance, seed=seed, time_limit=time_limit, iterations=p.iterations, solve_params=solve_params,
+                 pass1_share=p.pass1_share)
 
 
 # -- exact methods ---------------------------------------------------------------------------------

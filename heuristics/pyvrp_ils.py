@@ -29,7 +29,8 @@ Model (PyVRP's ``Model`` builder):
   covering plan from either pass: no plan.
 - stop: each pass ends at ``MaxIterations(iterations)`` (default :data:`ITERATIONS`, the
   reproducible stop: same seed, same plan) or at its share of the time limit (pass 1 at
-  ``PASS1_SHARE`` of it, pass 2 at the limit itself), whichever comes first (``info[pass]
+  ``pass1_share`` of it, default :data:`PASS1_SHARE`, pass 2 at the limit itself), whichever
+  comes first (``info[pass]
   ["stopped_by"]``). The time limit is the caller's, with no cap of its own; ``iterations=None``
   lets the time limit alone stop the passes. ``info["stop_reason"]`` is ``"iteration_limit"``
   when both passes ended on their iterations, ``"time_limit"`` when the clock cut one short.
@@ -63,6 +64,9 @@ from sarcover.heuristics.insertion import RouteSet
 RESOLUTION = 10**5  # integer distance units per E_max (rounding loses <= 1e-5 E_max per arc)
 ITERATIONS = 2000  # ILS iterations per pass, the reproducible stop
 PASS1_SHARE = 0.6  # with groups: share of the time limit pass 1 may use
+# bp's later, time-stopped calls: pass 1 only finds a covering start, pass 2 improves it (at
+# 360-600 points pass 2 gains in seconds what pass 1 does not in minutes; docs/heuristics.md)
+LATE_PASS1_SHARE = 0.1
 
 
 def _useful_nodes(instance: TOPInstance) -> np.ndarray:
@@ -270,7 +274,8 @@ def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: in
                       initial_solution=start_sol)
     best = res.best
     by_iterations = iterations is not None and res.num_iterations >= iterations
-    info = {"scale": sc.scale, "iterations": int(res.num_iterations), "covers": with_covers,
+    info = {"scale": sc.scale, "iterations": int(res.num_iterations), "seconds": float(res.runtime),
+            "covers": with_covers,
             "stopped_by": "iterations" if by_iterations else "time",
             "warnings": sorted({type(w.message).__name__ for w in caught})}
     if not best.is_feasible():
@@ -281,15 +286,18 @@ def _solve(instance: TOPInstance, nodes: np.ndarray, with_covers: bool, seed: in
 
 
 def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60.0,
-          iterations: int | None = ITERATIONS, solve_params=None) -> Result:
+          iterations: int | None = ITERATIONS, solve_params=None, pass1_share: float = PASS1_SHARE) -> Result:
     """Prize-collecting TOP by PyVRP (seeded, iteration-limited) plus group repair.
 
     With groups, pass 1 uses cover copies; pass 2 starts from pass 1's plan without them and
     repairs coverage afterwards (see the module docstring). ``iterations``: each pass's ILS
     iterations at most (None: only the time limit stops the passes); ``time_limit``: the
     seconds the whole method may take (None: none, then ``iterations`` must be given);
-    ``solve_params``: PyVRP's ``SolveParams`` for each pass (None: PyVRP's defaults).
+    ``solve_params``: PyVRP's ``SolveParams`` for each pass (None: PyVRP's defaults);
+    ``pass1_share``: the share of the time limit pass 1 may take (with groups), in (0, 1].
     """
+    if not 0.0 < pass1_share <= 1.0:
+        raise ValueError(f"pass1_share must be in (0, 1], got {pass1_share}")
     t0 = time.perf_counter()
     hist = History(t0)
     deadline = None if time_limit is None else t0 + float(time_limit)
@@ -335,7 +343,7 @@ def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60
 
     reason = "PyVRP found no plan within the budget"
     best_routes = None
-    share = None if deadline is None else t0 + PASS1_SHARE * float(time_limit)
+    share = None if deadline is None else t0 + pass1_share * float(time_limit)
     routes, run_info = _solve(instance, nodes, True, seed, share, iterations=iterations,
                               on_routes=lambda r, d: seen(first(r, d)), solve_params=solve_params)
     info["pass1"] = run_info
@@ -361,20 +369,22 @@ def pyvrp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None = 60
     return done(None, reason)
 
 
-def primal_routes(instance: TOPInstance, seed: int):
+def primal_routes(instance: TOPInstance, seed: int, late_pass1_share: float = LATE_PASS1_SHARE):
     """A primal heuristic for bp: ``run(seconds)`` returns PyVRP's routes (node ids) found within
     that time, or None without a plan. The first call is the registered method (``seed``,
     ``ITERATIONS`` per pass: a good plan in a few seconds); each later call searches with a new
     seed until its time is up, since on M = 20, K = 3 PyVRP still finds better plans after 2000
     iterations and another seed finds others, and on K = 5-6 a longer search finds better ones
-    still (docs/bp.md): those calls take all the seconds bp gives them."""
+    still (docs/bp.md): those calls take all the seconds bp gives them, pass 1 (cover copies)
+    only ``late_pass1_share`` of them, since pass 2 is where a long search gains."""
     calls = 0
 
     def run(seconds: float):
         nonlocal calls
         first = calls == 0
         res = pyvrp(instance, seed=seed + calls, time_limit=max(seconds, 0.05),
-                    iterations=ITERATIONS if first else None)
+                    iterations=ITERATIONS if first else None,
+                    pass1_share=PASS1_SHARE if first else late_pass1_share)
         calls += 1
         return None if res.plan is None else [list(r) for r in res.plan.routes]
 

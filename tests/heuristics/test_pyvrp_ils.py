@@ -88,3 +88,48 @@ def test_infeasible_cover_is_no_plan():
                        end=np.zeros(2), budget=10.0, n_vehicles=1, groups=((0,), (1,)))
     res = run_method("pyvrp", inst, time_limit=2.0)
     assert res.status == Status.NO_PLAN and res.plan is None and res.reason
+
+
+def test_pass1_share_splits_the_time_between_the_passes():
+    """Stopped by time, pass 1 (cover copies) ends at ``pass1_share`` of the limit and pass 2
+    searches the rest; the plan still covers every target. A share outside (0, 1] is refused."""
+    inst = to_top(generate(8, 2, 2, 0, e_max=6000.0))
+    short = pyvrp(inst, seed=0, time_limit=2.0, iterations=None, pass1_share=0.1)
+    long = pyvrp(inst, seed=0, time_limit=2.0, iterations=None)
+    assert short.info["pass1"]["seconds"] < 0.6 < 1.0 < short.info["pass2"]["seconds"]
+    assert long.info["pass1"]["seconds"] > 1.0 > long.info["pass2"]["seconds"]
+    for res in (short, long):
+        rep = verify(inst, res.plan)
+        assert rep.valid and rep.groups_covered == len(inst.groups)
+    for bad in (0.0, 1.5):
+        with pytest.raises(ValueError, match="pass1_share"):
+            pyvrp(inst, seed=0, time_limit=1.0, pass1_share=bad)
+
+
+def test_bps_later_primal_calls_give_pass_1_the_late_share(monkeypatch):
+    """primal_routes' first call keeps the method's split (PASS1_SHARE); the later, time-stopped
+    calls give pass 1 only LATE_PASS1_SHARE of their seconds."""
+    import sarcover.heuristics.pyvrp_ils as module
+
+    shares = []
+    real = module.pyvrp
+
+    def spy(*args, **kwargs):
+        res = real(*args, **kwargs)
+        shares.append((kwargs["pass1_share"], res.info["pass1"]["seconds"]))
+        return res
+
+    monkeypatch.setattr(module, "pyvrp", spy)
+    inst = to_top(generate(8, 2, 2, 0, e_max=6000.0))
+    run = module.primal_routes(inst, 3)
+    run(30.0)
+    assert verify(inst, Plan.of(run(2.0))).valid
+    assert [s for s, _ in shares] == [module.PASS1_SHARE, module.LATE_PASS1_SHARE]
+    assert shares[1][1] < 0.6
+
+
+def test_the_pyvrp_method_takes_pass1_share():
+    """The registered method passes its ``pass1_share`` parameter on (a user's setting)."""
+    inst = to_top(generate(8, 2, 2, 0, e_max=6000.0))
+    res = run_method("pyvrp", inst, seed=0, time_limit=2.0, params={"iterations": 10**9, "pass1_share": 0.1})
+    assert res.info["pass1"]["seconds"] < 0.6 < 1.0 < res.info["pass2"]["seconds"]
