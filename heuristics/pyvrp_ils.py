@@ -30,11 +30,10 @@ Model (PyVRP's ``Model`` builder):
 - stop: each pass ends at ``MaxIterations(iterations)`` (default :data:`ITERATIONS`, the
   reproducible stop: same seed, same plan) or at its share of the time limit (pass 1 at
   ``pass1_share`` of it, default :data:`PASS1_SHARE`, pass 2 at the limit itself), whichever
-  comes first (``info[pass]
-  ["stopped_by"]``). The time limit is the caller's, with no cap of its own; ``iterations=None``
-  lets the time limit alone stop the passes. ``info["stop_reason"]`` is ``"iteration_limit"``
-  when both passes ended on their iterations, ``"time_limit"`` when the clock cut one short.
-  Single-threaded.
+  comes first (``info[pass]["stopped_by"]``, its time in ``info[pass]["seconds"]``). The time
+  limit is the caller's, with no cap of its own; ``iterations=None`` lets the time limit alone
+  stop the passes. ``info["stop_reason"]`` is ``"iteration_limit"`` when both passes ended on
+  their iterations, ``"time_limit"`` when the clock cut one short. Single-threaded.
 - anytime history (``info["history"]``, :mod:`sarcover.formulations.history`): PyVRP's
   ``on_best`` callback hands over each new best solution; it is decoded and repaired exactly as
   the pass's final solution would be (pass 1: dedupe and refill; pass 2: group repair), and its
