@@ -132,6 +132,9 @@ class BPOptions:
       M = 20, K = 5-6 a 30 s PyVRP search found plans one better than bp's (10 s) on about a
       third of the instances bp left open, several of them then proven by the root's bound
       (docs/bp.md).
+    - ``primal_scale_share``, ``primal_scale_cap_s``: the same from ``primal_first_from``
+      points on, where the root takes most of the limit and the calls are few. 90 s: at 300 points PyVRP's search kept finding better plans up to about 60-70 s
+      where the 30 s call stopped short of them (docs/bp.md).
     - ``dive_share``: time for a dive at the root (30 s without a limit); later dives get less.
     - ``dive_every``, ``milp_every``: a dive every this many nodes, a MILP over the generated
       routes every this many nodes (when new routes came in).
@@ -207,6 +210,8 @@ class BPOptions:
     primal_late_share: float = _opt(0.5, "run the first primal call once this share of the limit is used if "
                                          "the root is still open", 0, 1)
     primal_cap_s: float = _opt(30.0, "at most this many seconds per primal heuristic call", 0)
+    primal_scale_share: float = _opt(0.15, "from primal_first_from points on, primal_share's place", 0, 1)
+    primal_scale_cap_s: float = _opt(90.0, "from primal_first_from points on, primal_cap_s's place", 0)
     dive_share: float = _opt(0.1, "time for a dive at the root, as a share of the time limit", 0, 1)
     dive_every: int = _opt(4, "a dive every this many nodes", 1)
     milp_every: int = _opt(10, "a MILP over the generated routes every this many nodes", 1)

@@ -66,9 +66,12 @@ class BranchAndPrice:
                              heuristic_columns=opts.heuristic_columns)
         self.elimination = Elimination(s, elim_limit=share(opts.elim_share),
                                        pool_routes=opts.pool_routes)
+        at_scale = s.problem.V >= opts.primal_first_from
+        primal_share, primal_cap = ((opts.primal_scale_share, opts.primal_scale_cap_s) if at_scale
+                                    else (opts.primal_share, opts.primal_cap_s))
         self.incumbents = IncumbentSearch(
             s, self.pricer, self.elimination, primal, dive_limit=share(opts.dive_share),
-            primal_limit=min(opts.primal_share * s.clock.limit, opts.primal_cap_s))
+            primal_limit=min(primal_share * s.clock.limit, primal_cap))
         self.cuts = CutRounds(s, self.elimination, rounds=opts.cut_rounds,
                               per_round=opts.cuts_per_round, gap=opts.cut_gap,
                               until=s.clock.until(opts.cut_share))

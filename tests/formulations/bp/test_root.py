@@ -205,6 +205,28 @@ def test_at_scale_the_heuristic_runs_before_the_roots_column_generation():
         assert (seen[:1] == [0]) == before_any_round
 
 
+def test_at_scale_the_heuristic_gets_the_scale_allowance():
+    """From primal_first_from points on, each call of the caller's heuristic may take
+    primal_scale_cap_s seconds (and primal_scale_share of the limit); below, primal_cap_s."""
+    from sarcover.formulations.bp.tree import BranchAndPrice
+    from sarcover.formulations.generate import generate
+    from sarcover.formulations.instance import to_top
+
+    inst = to_top(generate(6, 2, 2, 1))
+    for first_from, cap in [(0, 7.0), (10**6, 3.0)]:
+        seen = []
+        bp = BranchAndPrice(inst, time_limit=60, primal=seen.append,
+                            options=BPOptions(primal_first_from=first_from, primal_late_share=0.0,
+                                              primal_share=1.0, primal_cap_s=3.0,
+                                              primal_scale_share=1.0, primal_scale_cap_s=7.0,
+                                              cut_rounds=0))
+        bp.run()
+        assert seen and seen[0] == pytest.approx(cap)
+    bp = BranchAndPrice(inst, time_limit=60, primal=seen.append,
+                        options=BPOptions(primal_first_from=0, primal_scale_share=0.05))
+    assert bp.incumbents.primal_limit == pytest.approx(3.0)  # 5 % of 60 s, below the 90 s cap
+
+
 def test_at_scale_a_root_slow_to_settle_calls_the_heuristic_again():
     """At scale the call before column generation does not stand in for the late one: a root
     not settled by primal_late_share of the limit (here 0: at once) calls the heuristic again
