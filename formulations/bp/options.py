@@ -133,8 +133,9 @@ class BPOptions:
       third of the instances bp left open, several of them then proven by the root's bound
       (docs/bp.md).
     - ``primal_scale_share``, ``primal_scale_cap_s``: the same from ``primal_first_from``
-      points on, where the root takes most of the limit and the calls are few. 90 s: at 300 points PyVRP's search kept finding better plans up to about 60-70 s
-      where the 30 s call stopped short of them (docs/bp.md).
+      points on, where the root takes most of the limit and the calls are few. 90 s: at 300
+      points PyVRP's search kept finding better plans up to about 60-70 s, where the 30 s call
+      stopped short of them (docs/bp.md).
     - ``dive_share``: time for a dive at the root (30 s without a limit); later dives get less.
     - ``dive_every``, ``milp_every``: a dive every this many nodes, a MILP over the generated
       routes every this many nodes (when new routes came in).
