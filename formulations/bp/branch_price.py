@@ -24,7 +24,8 @@ def solve_bp(instance: TOPInstance, *, seed: int = 0, time_limit: float | None =
     as a first incumbent. ``primal(seconds) -> routes or None`` (node ids) is a heuristic run
     if the root does not settle the proof (after its first dive, and once more after its cut
     rounds and last dive), with ``options.primal_share`` of the time limit each (at most
-    ``options.primal_cap_s``); its routes become columns and, if verified and better, the
+    ``options.primal_cap_s``; from ``options.primal_first_from`` points on, the ``primal_scale``
+    pair); its routes become columns and, if verified and better, the
     incumbent. ``options``: None means :meth:`BPOptions.for_time_limit` of ``time_limit``.
     ``seed`` is unused (no randomness; timing-based choices and the time limit can still change
     the path taken). There is no pre-check here (``run_method`` runs it once per call): a group
