@@ -61,8 +61,10 @@ def branch(search: "Search", state: NodeState, x: np.ndarray, lp_value: float, s
     """Children of a node, or None if its LP solution is integral in visits and arcs. Of the
     ``strong`` most fractional candidates of each kind (groups if ``groups``, points, or arcs),
     the one whose children's re-solved LPs drop most below the node's value (product of the two
-    drops, each at least 1e-3 so that a free child does not hide the other). The master's bounds
-    are the node's again afterwards."""
+    drops, each at least 1e-3 so that a free child does not hide the other). The estimates stop
+    at the clock's deadline (each is an LP solve, seconds each at a few hundred points, and the
+    time limit holds): the best candidate so far is taken, the first when none was estimated.
+    The master's bounds are the node's again afterwards."""
     cands = branch_candidates(search, state, x, max(strong, 1), groups)
     if not cands:
         return None
@@ -72,6 +74,8 @@ def branch(search: "Search", state: NodeState, x: np.ndarray, lp_value: float, s
     t = time.perf_counter()
     best, pick = -1.0, cands[0]
     for pair in cands:
+        if search.clock.time_left() <= 0:
+            break
         drops = []
         for ch in pair:
             m.apply(ch)
@@ -80,7 +84,7 @@ def branch(search: "Search", state: NodeState, x: np.ndarray, lp_value: float, s
         score = drops[0] * drops[1]
         if score > best:
             best, pick = score, pair
-    search.stats.strong_lps += 2 * len(cands)
+        search.stats.strong_lps += 2
     m.apply(state)
     search.stats.strong_s += time.perf_counter() - t
     return pick

@@ -67,10 +67,13 @@ class IncumbentSearch:
 
     def run_milp(self, limit: float) -> None:
         """The best plan over the generated routes (HiGHS, started from the incumbent), within
-        ``limit`` seconds, over the routes that can be part of a better plan."""
+        ``limit`` seconds, over the routes that can be part of a better plan. A call that would
+        end in the clock's reserve (the last MILP) runs without HiGHS's presolve, which can
+        overrun its limit by seconds, so that the run ends at its time limit."""
         s = self.search
         s.stats.milp_calls += 1
         limit = min(limit, max(0.0, s.clock.hard_deadline - time.perf_counter() - 0.1))
+        presolve = time.perf_counter() + limit <= s.clock.deadline
         if limit > 0.05:
             t, before = time.perf_counter(), s.incumbent_value
             allowed = self.elimination.milp_columns()
@@ -78,7 +81,7 @@ class IncumbentSearch:
                 s.stats.milp_columns = int(allowed.sum())
                 if not allowed.any():
                     return  # no generated route can be part of a better plan
-            self.offer(s.master.milp(limit, allowed, start=s.incumbent))
+            self.offer(s.master.milp(limit, allowed, start=s.incumbent, presolve=presolve))
             s.stats.milp_s += time.perf_counter() - t
             s.stats.milp_improved += s.incumbent_value > before
 

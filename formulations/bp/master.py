@@ -481,11 +481,13 @@ class Master:
                 flows[(a, b)] = flows.get((a, b), 0.0) + float(x[r])
         return flows
 
-    def milp(self, time_limit: float, allowed: np.ndarray | None = None, start=None):
+    def milp(self, time_limit: float, allowed: np.ndarray | None = None, start=None,
+             presolve: bool = True):
         """Best integer selection of the generated routes (root rows, no branching); routes or
         None. ``allowed``: the routes it may use; ``start``: a plan (routes, each one of the
         generated ones) handed to HiGHS as its first solution, so that its search only looks
-        for better ones (within a short limit it finds better plans than without a start)."""
+        for better ones (within a short limit it finds better plans than without a start);
+        ``presolve``: HiGHS's (see :func:`.highs.packing_milp`)."""
         k = self.n_routes
         if k == 0:
             return None
@@ -504,7 +506,8 @@ class Master:
             x0 = np.zeros(k)
             x0[first] = 1.0
         h = packing_milp(self.row_lo, self.row_hi, np.asarray(self.route_prize), ub,
-                         starts[:-1].astype(np.int32), index, value, time_limit, first=x0)
+                         starts[:-1].astype(np.int32), index, value, time_limit, first=x0,
+                         presolve=presolve)
         if h.getInfo().primal_solution_status != 2:  # kSolutionStatusFeasible
             return None
         x = np.asarray(h.getSolution().col_value)

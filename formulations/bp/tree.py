@@ -134,15 +134,18 @@ class BranchAndPrice:
                     bound, x, xa, converged = self._solve_node(state, parent_bound)
                     if bound is None:
                         continue  # closed by listing its routes
-                if not converged and s.clock.time_left() <= 0:
-                    heapq.heappush(heap, self._node_key(bound, state.depth, counter, state))
-                    counter += 1
+                if s.prunable(bound):
+                    continue
+                if s.clock.time_left() <= 0:
+                    # no time to dive or branch (strong branching alone is ten LP solves, seconds
+                    # each at scale): the node is solved if its converged LP optimum is a plan,
+                    # else it stays open with its bound
+                    if not (converged and inc.offer_if_integral(x, xa)):
+                        heapq.heappush(heap, self._node_key(bound, state.depth, counter, state))
                     break
                 # not converged with time left: an exact pricing hit its label cap. The node's
                 # bound (its parent's, or one certified before the cap) still holds, so it is
                 # branched on its current LP: the children's pricing graphs are smaller
-                if s.prunable(bound):
-                    continue
                 if s.stats.nodes % opts.dive_every == 0 and s.clock.time_left() > 0:
                     # dive again from this node (other fixings than the root's dive)
                     inc.dive(min(0.3 * inc.dive_limit, 0.25 * s.clock.time_left()), start=state)
