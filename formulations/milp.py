@@ -432,6 +432,20 @@ def solve_milp(
     def left() -> float | None:
         return None if deadline is None else max(deadline - time.perf_counter(), 0.0)
 
+    loaded = False  # HiGHS holds a copy of the model
+
+    def load() -> float | None:
+        """HiGHS's copy of the model brought up to date, then the time left: Pyomo translates the
+        model when a solve starts (seconds at a few hundred points), so a limit taken before
+        that would end the solve past the run's time limit."""
+        nonlocal loaded
+        if loaded:
+            opt.update()
+        else:
+            opt.set_instance(m)
+            loaded = True
+        return left()
+
     def done(termination, plan=None, bound=None, reason=""):
         hist.record(info, verify(instance, plan).prize if plan is not None else None, bound)
         info["stop_reason"] = stop_reason_of(termination)
@@ -487,7 +501,10 @@ def solve_milp(
         for _ in range(root_rounds):
             if left() is not None and left() < 1.0:
                 break
-            res = opt.solve(m, time_limit=left(), **common)
+            tl = load()
+            if tl is not None and tl < 1.0:
+                break
+            res = opt.solve(m, time_limit=tl, **common)
             if res.termination_condition != TerminationCondition.convergenceCriteriaSatisfied:
                 break
             res.solution_loader.load_vars()
@@ -514,12 +531,14 @@ def solve_milp(
     rounds, cuts_int, nogoods, warm = 0, 0, 0, False
     while True:
         rounds += 1
-        tl = left()
+        if left() is not None and left() <= 0.0:
+            proven = False
+            break
+        tl = load()
         if tl is not None and tl <= 0.0:
             proven = False
             break
         if rounds == 1 and warm_start is not None:
-            opt.set_instance(m)
             warm = _set_warm_start(opt, m, warm_start, g)
         res = opt.solve(m, time_limit=tl, **common)
         tc = res.termination_condition

@@ -194,6 +194,37 @@ def test_registered_method_starts_from_greedy():
     assert result.status == Status.OPTIMAL and result.objective == 2
 
 
+def test_highs_limits_count_the_models_translation(monkeypatch):
+    """Pyomo translates the model for HiGHS when a solve starts (seconds at a few hundred
+    points): it is translated once, before the time left is taken, so that every HiGHS solve
+    (the root's LP rounds and the MILP, warm started) is limited to end by the run's deadline."""
+    import time
+
+    from pyomo.contrib.solver.solvers.highs import Highs
+
+    loads, solves = [], []
+    set_instance, run = Highs.set_instance, Highs._solve
+
+    def counted(self, model):
+        loads.append(model)
+        return set_instance(self, model)
+
+    def timed(self):
+        solves.append((time.perf_counter(), self._active_config.time_limit))
+        return run(self)
+
+    monkeypatch.setattr(Highs, "set_instance", counted)
+    monkeypatch.setattr(Highs, "_solve", timed)
+    inst = read_top(TOP_DIR / "p3.2.j.txt")
+    limit = 3.0
+    t0 = time.perf_counter()
+    result = solve_milp(inst, time_limit=limit, warm_start=Plan.of([]))
+    assert result.status in (Status.TIME_LIMIT, Status.OPTIMAL) and result.info["warm_start"] is True
+    assert len(loads) == 1 and len(solves) >= 2  # LP rounds, then the MILP
+    # the solve's own check for changes since (milliseconds here) is all that may come after
+    assert all(start + tl <= t0 + limit + 0.05 for start, tl in solves)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(n for n in PUBLISHED if n.split(".")[0] in ("p1", "p2", "p3")))
 def test_top_sets_1_to_3(name):
