@@ -499,9 +499,9 @@ def solve_milp(
             v.domain = pyo.UnitInterval
         lp_bounds = []
         for _ in range(root_rounds):
-            if left() is not None and left() < 1.0:
-                break
-            tl = load()
+            tl = left()
+            if tl is None or tl >= 1.0:  # no translation once too little time is left
+                tl = load()
             if tl is not None and tl < 1.0:
                 break
             res = opt.solve(m, time_limit=tl, **common)
@@ -531,10 +531,9 @@ def solve_milp(
     rounds, cuts_int, nogoods, warm = 0, 0, 0, False
     while True:
         rounds += 1
-        if left() is not None and left() <= 0.0:
-            proven = False
-            break
-        tl = load()
+        tl = left()
+        if tl is None or tl > 0.0:  # no translation once the time is up
+            tl = load()
         if tl is not None and tl <= 0.0:
             proven = False
             break

@@ -65,8 +65,9 @@ def packing_milp(lo, hi, prize, ub, starts, index, value, time_limit: float, *,
     first entries), rows between ``lo`` and ``hi``, maximised to a zero relative gap (and zero
     absolute gap with ``abs_gap``) within ``time_limit`` seconds; ``first``: a 0/1 first
     solution. ``presolve=False`` where the time limit must hold to the second: HiGHS's MIP
-    presolve does not look at the clock everywhere (HiGHS issue 1501): over thousands of routes
-    it can run seconds past a short limit. The caller reads the outcome from the returned solver."""
+    presolve does not look at the clock everywhere, and over thousands of routes it can run
+    seconds past a short limit (docs/bp.md, "The time limit"). The caller reads the outcome from
+    the returned solver."""
     k = len(prize)
     h = quiet_highs()
     h.setOptionValue("time_limit", max(0.05, float(time_limit)))

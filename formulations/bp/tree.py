@@ -146,7 +146,7 @@ class BranchAndPrice:
                 # not converged with time left: an exact pricing hit its label cap. The node's
                 # bound (its parent's, or one certified before the cap) still holds, so it is
                 # branched on its current LP: the children's pricing graphs are smaller
-                if s.stats.nodes % opts.dive_every == 0 and s.clock.time_left() > 0:
+                if s.stats.nodes % opts.dive_every == 0:
                     # dive again from this node (other fixings than the root's dive)
                     inc.dive(min(0.3 * inc.dive_limit, 0.25 * s.clock.time_left()), start=state)
                     m.apply(state)
