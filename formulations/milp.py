@@ -39,6 +39,14 @@ the verifier accepts is cut off (the bound is valid). A plan HiGHS returns that 
 rejects (possible only within HiGHS's feasibility tolerance) is never reported: its route is cut
 off by a no-good cut, which removes only that infeasible route, and the model is re-solved.
 
+Time limit: every HiGHS solve is limited to end by the run's deadline. The model is translated
+for HiGHS once, before the time left is taken. HiGHS stops an LP solve on its run clock, which goes
+on over every solve of one model (a MIP solve counts from its own start), so an LP round's limit
+is that clock plus the time left. HiGHS's MIP presolve does not check the clock everywhere, so a
+MILP given less time than an LP round took (too little to solve its own root LP) runs without it,
+and one given less than that or a second is not started. HiGHS's setup of a MIP before its first
+check of the clock (about a second at a few hundred points) is what may still pass the deadline.
+
 Anytime history (``info["history"]``, see :mod:`sarcover.formulations.history`): ``[t, incumbent, bound]``
 points in prize units, t from the call of :func:`solve_milp`. Incumbents are verified plans only:
 the warm start, and every improving MIP solution HiGHS reports (``cbMipImprovingSolution``, read
@@ -433,18 +441,32 @@ def solve_milp(
         return None if deadline is None else max(deadline - time.perf_counter(), 0.0)
 
     loaded = False  # HiGHS holds a copy of the model
+    # HiGHS's run clock: the seconds its solves of this copy took in all. HiGHS stops an LP solve
+    # once this total passes the LP's limit (a MIP solve counts from its own start), so an LP
+    # round after the first is given the clock plus the time left.
+    highs_clock = 0.0
 
     def load() -> float | None:
         """HiGHS's copy of the model brought up to date, then the time left: Pyomo translates the
         model when a solve starts (seconds at a few hundred points), so a limit taken before
         that would end the solve past the run's time limit."""
-        nonlocal loaded
+        nonlocal loaded, highs_clock
         if loaded:
             opt.update()
         else:
             opt.set_instance(m)
-            loaded = True
+            loaded, highs_clock = True, 0.0
         return left()
+
+    def run(time_limit: float | None, **options):
+        """One HiGHS solve; ``options`` are added to the run's HiGHS options for this solve."""
+        nonlocal highs_clock
+        kw = dict(common, solver_options={**common["solver_options"], **options})
+        res = opt.solve(m, time_limit=time_limit, **kw)
+        clock = getattr(res.timing_info, "highs_time", None)
+        if clock is not None:
+            highs_clock = float(clock)
+        return res
 
     def done(termination, plan=None, bound=None, reason=""):
         hist.record(info, verify(instance, plan).prize if plan is not None else None, bound)
@@ -491,6 +513,7 @@ def solve_milp(
 
     # Root cut loop on the LP relaxation: connectivity cuts the time flow leaves violated.
     cuts_lp, cuts_clique = 0, 0
+    lp_s = 0.0  # the longest LP round
     inc = incompatibility(g) if cliques else None
     if root_rounds > 0:
         for v in m.x.values():
@@ -504,7 +527,9 @@ def solve_milp(
                 tl = load()
             if tl is not None and tl < 1.0:
                 break
-            res = opt.solve(m, time_limit=tl, **common)
+            t_lp = time.perf_counter()
+            res = run(None if tl is None else highs_clock + tl)
+            lp_s = max(lp_s, time.perf_counter() - t_lp)
             if res.termination_condition != TerminationCondition.convergenceCriteriaSatisfied:
                 break
             res.solution_loader.load_vars()
@@ -534,12 +559,20 @@ def solve_milp(
         tl = left()
         if tl is None or tl > 0.0:  # no translation once the time is up
             tl = load()
-        if tl is not None and tl <= 0.0:
+        # HiGHS sets a MIP up before it first checks the clock (2 s at a few hundred points), so
+        # a MIP is not started with less time than an LP round took, or than a second
+        if tl is not None and (tl <= 0.0 or tl < min(1.0, lp_s)):
             proven = False
             break
         if rounds == 1 and warm_start is not None:
             warm = _set_warm_start(opt, m, warm_start, g)
-        res = opt.solve(m, time_limit=tl, **common)
+        # HiGHS's MIP presolve does not check the clock everywhere and can run seconds past the
+        # limit. A MIP given less time than an LP round took cannot solve its own root LP, so
+        # presolve would buy it nothing but the overrun.
+        short = tl is not None and tl < lp_s
+        if short:
+            info["presolve_off"] = True
+        res = run(tl, presolve="off" if short else "choose")  # an option stays set on HiGHS's copy
         tc = res.termination_condition
         info["highs_termination"] = str(tc.name)
         info["mip_nodes"] = getattr(res.extra_info, "mip_node_count", None)

@@ -6,6 +6,7 @@ import csv
 import itertools
 import math
 
+import highspy
 import numpy as np
 import pytest
 
@@ -197,7 +198,10 @@ def test_registered_method_starts_from_greedy():
 def test_highs_limits_count_the_models_translation(monkeypatch):
     """Pyomo translates the model for HiGHS when a solve starts (seconds at a few hundred
     points): it is translated once, before the time left is taken, so that every HiGHS solve
-    (the root's LP rounds and the MILP, warm started) is limited to end by the run's deadline."""
+    (the root's LP rounds and the MILP, warm started) is limited to end by the run's deadline.
+    An LP solve's limit counts on HiGHS's run clock, which goes on over the solves of one model
+    (:func:`test_highs_stops_an_lp_on_its_run_clock_and_a_mip_on_its_own`): every LP round is
+    given the time left, not the time left less what the rounds before it took."""
     import time
 
     from pyomo.contrib.solver.solvers.highs import Highs
@@ -210,7 +214,9 @@ def test_highs_limits_count_the_models_translation(monkeypatch):
         return set_instance(self, model)
 
     def timed(self):
-        solves.append((time.perf_counter(), self._active_config.time_limit))
+        h = self._solver_model
+        mip = any(t != highspy.HighsVarType.kContinuous for t in h.getLp().integrality_)
+        solves.append((time.perf_counter(), self._active_config.time_limit, h.getRunTime(), mip))
         return run(self)
 
     monkeypatch.setattr(Highs, "set_instance", counted)
@@ -220,9 +226,83 @@ def test_highs_limits_count_the_models_translation(monkeypatch):
     t0 = time.perf_counter()
     result = solve_milp(inst, time_limit=limit, warm_start=Plan.of([]))
     assert result.status in (Status.TIME_LIMIT, Status.OPTIMAL) and result.info["warm_start"] is True
-    assert len(loads) == 1 and len(solves) >= 2  # LP rounds, then the MILP
-    # the solve's own check for changes since (milliseconds here) is all that may come after
-    assert all(start + tl <= t0 + limit + 0.05 for start, tl in solves)
+    lps = [s for s in solves if not s[3]]
+    assert len(loads) == 1 and len(lps) >= 2 and len(solves) > len(lps)  # LP rounds, then the MILP
+    assert lps[-1][2] > 0.01  # the rounds before the last took HiGHS time
+    for start, tl, clock, mip in solves:
+        end = start + (tl if mip else tl - clock)  # when HiGHS stops the solve
+        # the solve's own check for changes since (milliseconds here) is all that may come after
+        assert end <= t0 + limit + 0.05
+        if not mip:  # and the time taken before the solve began is all that comes before
+            assert end >= t0 + limit - 0.05
+
+
+@pytest.mark.parametrize("limit, mip", [(2.3, None), (3.0, "off"), (6.0, "choose")])
+def test_a_short_milp_runs_without_presolve(monkeypatch, limit, mip):
+    """HiGHS's MIP presolve does not check the clock everywhere (8 s on a 3 s limit at 120
+    points), and HiGHS sets a MIP up before its first check. So after an LP round of 1.5 s
+    (made slow here), a MILP given less than that runs without presolve, one given less than a
+    second is not started, and one given more runs with it."""
+    import time
+
+    from pyomo.contrib.solver.solvers.highs import Highs
+
+    run, mips = Highs._solve, []
+
+    def slow_first_lp(self):
+        h = self._solver_model
+        if any(t != highspy.HighsVarType.kContinuous for t in h.getLp().integrality_):
+            mips.append(dict(self._active_config.solver_options.items()).get("presolve"))
+        elif not hasattr(self, "slowed"):
+            self.slowed = True
+            time.sleep(1.5)
+        return run(self)
+
+    monkeypatch.setattr(Highs, "_solve", slow_first_lp)
+    result = solve_milp(read_top(TOP_DIR / "p3.2.j.txt"), time_limit=limit, warm_start=Plan.of([]))
+    assert result.status in (Status.TIME_LIMIT, Status.OPTIMAL)
+    assert result.info["lp_bounds"]  # the LP rounds ran
+    assert mips == ([] if mip is None else [mip] * len(mips)) and (mip is None or mips)
+    assert result.info.get("presolve_off", False) == (mip == "off")
+
+
+def test_highs_stops_an_lp_on_its_run_clock_and_a_mip_on_its_own():
+    """What :func:`solve_milp`'s limits rely on: HiGHS stops an LP solve once its run clock (the
+    time of every solve of this Highs object) passes the limit, and a MIP solve once its own
+    time does. If an upgrade of HiGHS changes this, milp's LP limits must change with it."""
+    rng = np.random.default_rng(0)
+    n, m = 2000, 1000
+    h = highspy.Highs()
+    h.setOptionValue("output_flag", False)
+    h.setOptionValue("threads", 1)
+    h.addVars(n, np.zeros(n), np.ones(n))
+    h.changeColsCost(n, np.arange(n, dtype=np.int32), -rng.random(n))
+    for _ in range(m):
+        idx = np.sort(rng.choice(n, 30, replace=False)).astype(np.int32)
+        h.addRow(-highspy.kHighsInf, 3.0, len(idx), idx, rng.random(30) + 0.5)
+    h.run()
+    assert h.getModelStatus() == highspy.HighsModelStatus.kOptimal
+    clock = h.getRunTime()
+    assert clock > 0.02
+
+    h.changeColCost(0, -2.0)  # an LP a few pivots away, given less time than the clock shows
+    h.setOptionValue("time_limit", clock / 2)
+    h.run()
+    assert h.getModelStatus() == highspy.HighsModelStatus.kTimeLimit
+    h.setOptionValue("time_limit", h.getRunTime() + 30.0)  # the clock plus the time it may take
+    h.run()
+    assert h.getModelStatus() == highspy.HighsModelStatus.kOptimal
+
+    h.clearModel()  # a tiny MIP, given less time than the clock shows: it is solved
+    h.addVars(2, np.zeros(2), np.ones(2))
+    h.changeColsCost(2, np.arange(2, dtype=np.int32), np.array([-1.0, -1.0]))
+    h.changeColsIntegrality(2, np.arange(2, dtype=np.int32), np.array([highspy.HighsVarType.kInteger] * 2))
+    h.addRow(-highspy.kHighsInf, 1.5, 2, np.arange(2, dtype=np.int32), np.ones(2))
+    assert h.getRunTime() >= clock
+    h.setOptionValue("time_limit", clock / 2)
+    h.run()
+    assert h.getModelStatus() == highspy.HighsModelStatus.kOptimal
+    assert h.getInfo().objective_function_value == pytest.approx(-1.0)
 
 
 @pytest.mark.slow
