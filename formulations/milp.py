@@ -44,8 +44,9 @@ for HiGHS once, before the time left is taken. HiGHS stops an LP solve on its ru
 on over every solve of one model (a MIP solve counts from its own start), so an LP round's limit
 is that clock plus the time left. HiGHS's MIP presolve does not check the clock everywhere, so a
 MILP given less time than an LP round took (too little to solve its own root LP) runs without it,
-and one given less than that or a second is not started. HiGHS's setup of a MIP before its first
-check of the clock (about a second at a few hundred points) is what may still pass the deadline.
+and one given less than a second (or than an LP round took, if that was shorter) is not started.
+What may still pass the deadline: HiGHS's setup of a MIP before its first check of the clock
+(2 s at 120 points), and the root's separation rounds of a MIP, between which it checks.
 
 Anytime history (``info["history"]``, see :mod:`sarcover.formulations.history`): ``[t, incumbent, bound]``
 points in prize units, t from the call of :func:`solve_milp`. Incumbents are verified plans only:
@@ -559,8 +560,8 @@ def solve_milp(
         tl = left()
         if tl is None or tl > 0.0:  # no translation once the time is up
             tl = load()
-        # HiGHS sets a MIP up before it first checks the clock (2 s at a few hundred points), so
-        # a MIP is not started with less time than an LP round took, or than a second
+        # HiGHS sets a MIP up before it first checks the clock (2 s at 120 points), so a MIP is
+        # not started with less than a second, or than an LP round took if that was shorter
         if tl is not None and (tl <= 0.0 or tl < min(1.0, lp_s)):
             proven = False
             break
