@@ -46,7 +46,8 @@ is that clock plus the time left. HiGHS's MIP presolve does not check the clock 
 MILP given less time than an LP round took (too little to solve its own root LP) runs without it,
 and one given less than a second (or than an LP round took, if that was shorter) is not started.
 What may still pass the deadline: HiGHS's setup of a MIP before its first check of the clock
-(2 s at 120 points), and the root's separation rounds of a MIP, between which it checks.
+(seconds at 120 points, docs/scale.md), and the root's separation rounds of a MIP, between
+which it checks.
 
 Anytime history (``info["history"]``, see :mod:`sarcover.formulations.history`): ``[t, incumbent, bound]``
 points in prize units, t from the call of :func:`solve_milp`. Incumbents are verified plans only:
@@ -560,7 +561,7 @@ def solve_milp(
         tl = left()
         if tl is None or tl > 0.0:  # no translation once the time is up
             tl = load()
-        # HiGHS sets a MIP up before it first checks the clock (2 s at 120 points), so a MIP is
+        # HiGHS sets a MIP up before it first checks the clock (seconds at 120 points), so a MIP is
         # not started with less than a second, or than an LP round took if that was shorter
         if tl is not None and (tl <= 0.0 or tl < min(1.0, lp_s)):
             proven = False

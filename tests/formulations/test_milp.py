@@ -239,8 +239,8 @@ def test_highs_limits_count_the_models_translation(monkeypatch):
 
 @pytest.mark.parametrize("limit, mip", [(2.3, None), (3.0, "off"), (6.0, "choose")])
 def test_a_short_milp_runs_without_presolve(monkeypatch, limit, mip):
-    """HiGHS's MIP presolve does not check the clock everywhere (8 s on a 3 s limit at 120
-    points), and HiGHS sets a MIP up before its first check. So after an LP round of 1.5 s
+    """HiGHS's MIP presolve does not check the clock everywhere (seconds past a short limit at
+    120 points, docs/scale.md), and HiGHS sets a MIP up before its first check. So after an LP round of 1.5 s
     (made slow here), a MILP given less than that runs without presolve, one given less than a
     second is not started, and one given more runs with it."""
     import time
