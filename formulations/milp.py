@@ -452,12 +452,12 @@ def solve_milp(
         """HiGHS's copy of the model brought up to date, then the time left: Pyomo translates the
         model when a solve starts (seconds at a few hundred points), so a limit taken before
         that would end the solve past the run's time limit."""
-        nonlocal loaded, highs_clock
+        nonlocal loaded
         if loaded:
             opt.update()
         else:
             opt.set_instance(m)
-            loaded, highs_clock = True, 0.0
+            loaded = True
         return left()
 
     def run(time_limit: float | None, **options):

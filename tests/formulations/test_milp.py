@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from sarcover.benchmarks.registry import run_method
+from sarcover.formulations.bp.highs import quiet_highs
 from sarcover.formulations.instance import TOPInstance
 from sarcover.formulations.io import read_top
 from sarcover.formulations.milp import build_milp, solve_milp
@@ -195,6 +196,11 @@ def test_registered_method_starts_from_greedy():
     assert result.status == Status.OPTIMAL and result.objective == 2
 
 
+def is_mip(h: highspy.Highs) -> bool:
+    """Whether HiGHS's copy of the model has an integer column (a MILP solve, not an LP round)."""
+    return any(t != highspy.HighsVarType.kContinuous for t in h.getLp().integrality_)
+
+
 def test_highs_limits_count_the_models_translation(monkeypatch):
     """Pyomo translates the model for HiGHS when a solve starts (seconds at a few hundred
     points): it is translated once, before the time left is taken, so that every HiGHS solve
@@ -215,8 +221,7 @@ def test_highs_limits_count_the_models_translation(monkeypatch):
 
     def timed(self):
         h = self._solver_model
-        mip = any(t != highspy.HighsVarType.kContinuous for t in h.getLp().integrality_)
-        solves.append((time.perf_counter(), self._active_config.time_limit, h.getRunTime(), mip))
+        solves.append((time.perf_counter(), self._active_config.time_limit, h.getRunTime(), is_mip(h)))
         return run(self)
 
     monkeypatch.setattr(Highs, "set_instance", counted)
@@ -240,9 +245,9 @@ def test_highs_limits_count_the_models_translation(monkeypatch):
 @pytest.mark.parametrize("limit, mip", [(2.3, None), (3.0, "off"), (6.0, "choose")])
 def test_a_short_milp_runs_without_presolve(monkeypatch, limit, mip):
     """HiGHS's MIP presolve does not check the clock everywhere (seconds past a short limit at
-    120 points, docs/scale.md), and HiGHS sets a MIP up before its first check. So after an LP round of 1.5 s
-    (made slow here), a MILP given less than that runs without presolve, one given less than a
-    second is not started, and one given more runs with it."""
+    120 points, docs/scale.md), and HiGHS sets a MIP up before its first check. So after an LP
+    round of 1.5 s (made slow here), a MILP given less than that runs without presolve, one
+    given less than a second is not started, and one given more runs with it."""
     import time
 
     from pyomo.contrib.solver.solvers.highs import Highs
@@ -250,8 +255,7 @@ def test_a_short_milp_runs_without_presolve(monkeypatch, limit, mip):
     run, mips = Highs._solve, []
 
     def slow_first_lp(self):
-        h = self._solver_model
-        if any(t != highspy.HighsVarType.kContinuous for t in h.getLp().integrality_):
+        if is_mip(self._solver_model):
             mips.append(dict(self._active_config.solver_options.items()).get("presolve"))
         elif not hasattr(self, "slowed"):
             self.slowed = True
@@ -272,9 +276,7 @@ def test_highs_stops_an_lp_on_its_run_clock_and_a_mip_on_its_own():
     time does. If an upgrade of HiGHS changes this, milp's LP limits must change with it."""
     rng = np.random.default_rng(0)
     n, m = 2000, 1000
-    h = highspy.Highs()
-    h.setOptionValue("output_flag", False)
-    h.setOptionValue("threads", 1)
+    h = quiet_highs()
     h.addVars(n, np.zeros(n), np.ones(n))
     h.changeColsCost(n, np.arange(n, dtype=np.int32), -rng.random(n))
     for _ in range(m):
