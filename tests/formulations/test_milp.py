@@ -242,11 +242,11 @@ def test_highs_limits_count_the_models_translation(monkeypatch):
             assert end >= t0 + limit - 0.05
 
 
-@pytest.mark.parametrize("limit, mip", [(2.3, None), (3.0, "off"), (6.0, "choose")])
+@pytest.mark.parametrize("limit, mip", [(3.6, None), (5.0, "off"), (9.0, "choose")])
 def test_a_short_milp_runs_without_presolve(monkeypatch, limit, mip):
     """HiGHS's MIP presolve does not check the clock everywhere (seconds past a short limit at
     120 points, docs/scale.md), and HiGHS sets a MIP up before its first check. So after an LP
-    round of 1.5 s (made slow here), a MILP given less than that runs without presolve, one
+    round of 3 s (made slow here), a MILP given less than that runs without presolve, one
     given less than a second is not started, and one given more runs with it."""
     import time
 
@@ -259,7 +259,7 @@ def test_a_short_milp_runs_without_presolve(monkeypatch, limit, mip):
             mips.append(dict(self._active_config.solver_options.items()).get("presolve"))
         elif not hasattr(self, "slowed"):
             self.slowed = True
-            time.sleep(1.5)
+            time.sleep(3.0)  # the MILP's window at 5 s, [1, 3) s left, holds a slow machine
         return run(self)
 
     monkeypatch.setattr(Highs, "_solve", slow_first_lp)
